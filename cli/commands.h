@@ -1,0 +1,29 @@
+// The registry of subcommands. Each cli/<name>_command.cpp defines one
+// `Command Add<Name>Command(CLI::App&)` that adds its subcommand, binds its options and
+// returns the action that runs it; AllCommands() lists them.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace subflow::cli {
+
+struct Command {
+  CLI::App* subcommand = nullptr;
+  std::function<void()> run;  // called after parsing when `subcommand` was given
+};
+
+using AddCommandFunction = Command (*)(CLI::App&);
+
+inline std::vector<AddCommandFunction> AllCommands() {
+  return {};
+}
+
+// Runs the command whose subcommand was parsed. A subflow::Error is printed in one line
+// ("subflow <command>: error: ...") and gives exit code 1; success gives 0.
+int RunSelected(const std::vector<Command>& commands, bool verbose);
+
+}  // namespace subflow::cli
