@@ -1,0 +1,44 @@
+// Reading and writing triangle meshes: PLY (ascii, binary little/big endian) and OBJ.
+// Readers validate what they read and throw subflow::Error naming the file, the element
+// (line, vertex, face) and what was expected: non-triangle faces, indices out of range,
+// NaN/Inf coordinates, truncated data, unknown formats. Manifoldness is checked by
+// MeshTopology (ReadMesh does it when `require_manifold` is set).
+// Writers never leave a half-written file: they write to "<path>.tmp" and rename.
+#pragma once
+
+#include <map>
+#include <vector>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "geometry/triangle_mesh.h"
+
+namespace subflow::geometry {
+
+// Extra per-vertex scalar properties (e.g. "vx", "vy", "vz" for scene flow), each a
+// column of #V values, written as float after x y z in the order of the map's keys
+// unless an explicit order is given.
+struct VertexProperties {
+  std::vector<std::string> names;           // order in the file
+  std::map<std::string, Eigen::VectorXd> values;  // name → #V values
+};
+
+struct MeshReadOptions {
+  bool require_manifold = true;  // check with MeshTopology; throws on non-manifold input
+};
+
+// Reads .ply or .obj (by extension, case-insensitive). Polygons with more than three
+// vertices are an error (subflow works on triangle meshes only).
+TriangleMesh ReadMesh(const std::string& path, const MeshReadOptions& options = {},
+                      VertexProperties* properties = nullptr);
+
+enum class PlyFormat { kAscii, kBinaryLittleEndian };
+
+// Writes .ply (binary little-endian by default: float x y z [+ properties], faces as
+// "uchar int" lists) or .obj, by extension.
+void WriteMesh(const std::string& path, const TriangleMesh& mesh,
+               const VertexProperties* properties = nullptr,
+               PlyFormat ply_format = PlyFormat::kBinaryLittleEndian);
+
+}  // namespace subflow::geometry

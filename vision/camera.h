@@ -1,0 +1,67 @@
+// A calibrated pinhole camera with optional OpenCV lens distortion, in the convention of
+// ../shared/DATASET.md (OpenCV / COLMAP):
+//   camera coordinates  Xc = R X + t   (+z forward, +x right, +y down)
+//   pixel               p = (fx Xc.x / Xc.z + cx, fy Xc.y / Xc.z + cy) (+ skew K(0,1))
+//   pixel (0, 0) is the CENTRE of the top-left pixel; P = K [R | t] (method eq. 4).
+// Distortion (k1 k2 p1 p2 k3) is applied by Project/Distort in normalized coordinates,
+// as cv::projectPoints does. The reconstruction works on undistorted images (see
+// UndistortImage), so its hot paths use ProjectUndistorted and its Jacobian.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+namespace subflow::vision {
+
+class Camera {
+ public:
+  Camera() = default;
+  // Throws subflow::Error naming `source` when K is not a valid intrinsic matrix
+  // (fx, fy > 0, last row (0, 0, 1)), R is not a rotation (RᵀR = I and det R = +1 to 1e-6),
+  // sizes are not positive, or any value is not finite.
+  Camera(std::string name, int width, int height, const Eigen::Matrix3d& K,
+         const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+         const Eigen::VectorXd& distortion = Eigen::VectorXd(), const std::string& source = "");
+
+  const std::string& name() const { return name_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const Eigen::Matrix3d& K() const { return K_; }
+  const Eigen::Matrix3d& R() const { return R_; }
+  const Eigen::Vector3d& t() const { return t_; }
+  // k1 k2 p1 p2 k3 (5 values, zeros when the camera has none).
+  const Eigen::Matrix<double, 5, 1>& distortion() const { return distortion_; }
+  bool HasDistortion() const { return distortion_.cwiseAbs().maxCoeff() > 0; }
+
+  Eigen::Vector3d Center() const { return -R_.transpose() * t_; }  // in world coordinates
+  Eigen::Vector3d ViewDirection() const { return R_.row(2).transpose(); }  // optical axis
+  Eigen::Matrix<double, 3, 4> ProjectionMatrix() const;                  // K [R | t]
+
+  Eigen::Vector3d ToCamera(const Eigen::Vector3d& X) const { return R_ * X + t_; }
+  // Pixel of a world point including distortion; depth (Xc.z) returned if asked.
+  Eigen::Vector2d Project(const Eigen::Vector3d& X, double* depth = nullptr) const;
+  // Pixel of a world point in the undistorted image (pure pinhole K [R | t]).
+  Eigen::Vector2d ProjectUndistorted(const Eigen::Vector3d& X, double* depth = nullptr) const;
+  // ∂p/∂X, the 2×3 Jacobian of ProjectUndistorted at X (method eq. 24's ∂p_k/∂P).
+  Eigen::Matrix<double, 2, 3> ProjectionJacobian(const Eigen::Vector3d& X) const;
+  // Unit direction (world) of the ray through an undistorted pixel; the ray starts at Center().
+  Eigen::Vector3d BackProjectUndistorted(const Eigen::Vector2d& pixel) const;
+  // Ray through a pixel of the distorted (raw) image.
+  Eigen::Vector3d BackProject(const Eigen::Vector2d& pixel) const;
+  bool InImage(const Eigen::Vector2d& pixel, double margin = 0.0) const;
+
+  // Resamples a raw image to the undistorted pinhole camera with the same K.
+  cv::Mat UndistortImage(const cv::Mat& image, int interpolation = 1 /* cv::INTER_LINEAR */) const;
+
+ private:
+  std::string name_;
+  int width_ = 0, height_ = 0;
+  Eigen::Matrix3d K_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 5, 1> distortion_ = Eigen::Matrix<double, 5, 1>::Zero();
+};
+
+}  // namespace subflow::vision
