@@ -18,8 +18,18 @@ struct Command {
 
 using AddCommandFunction = Command (*)(CLI::App&);
 
+Command AddCheckCommand(CLI::App& app);  // cli/check_command.cpp
+Command AddSynthCommand(CLI::App& app);  // cli/synth_command.cpp
+Command AddEvalCommand(CLI::App& app);   // cli/eval_command.cpp
+Command AddSubdivideCommand(CLI::App& app);  // cli/subdivide_command.cpp
+
 inline std::vector<AddCommandFunction> AllCommands() {
-  return {};
+  return {
+      AddCheckCommand,
+      AddSynthCommand,
+      AddEvalCommand,
+      AddSubdivideCommand,
+  };
 }
 
 // Runs the command whose subcommand was parsed. A subflow::Error is printed in one line

@@ -36,7 +36,9 @@ TriangleMesh ReadMesh(const std::string& path, const MeshReadOptions& options = 
 enum class PlyFormat { kAscii, kBinaryLittleEndian };
 
 // Writes .ply (binary little-endian by default: float x y z [+ properties], faces as
-// "uchar int" lists) or .obj, by extension.
+// "uchar int" lists) or .obj, by extension. The directory must exist; OBJ cannot hold
+// properties (non-empty properties with a .obj path are an error); non-finite positions
+// and out-of-range indices are refused. Formats: geometry/ply_io.h, geometry/obj_io.h.
 void WriteMesh(const std::string& path, const TriangleMesh& mesh,
                const VertexProperties* properties = nullptr,
                PlyFormat ply_format = PlyFormat::kBinaryLittleEndian);

@@ -50,6 +50,8 @@ class Camera {
   Eigen::Vector3d BackProjectUndistorted(const Eigen::Vector2d& pixel) const;
   // Ray through a pixel of the distorted (raw) image.
   Eigen::Vector3d BackProject(const Eigen::Vector2d& pixel) const;
+  // True when pixel ∈ [−½ + margin, w − ½ − margin) × [−½ + margin, h − ½ − margin): the
+  // image area in the pixel-centre convention, shrunk by `margin` pixels (negative grows it).
   bool InImage(const Eigen::Vector2d& pixel, double margin = 0.0) const;
 
   // Resamples a raw image to the undistorted pinhole camera with the same K.

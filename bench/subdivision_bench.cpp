@@ -1,0 +1,135 @@
+// Re-synthesis is the optimizer's hot path: base control points + details in local
+// frames → control points of the finest level. This compares, in one run, on an
+// icosphere of 1280 faces (displaced so it is not symmetric) subdivided 4 times
+// (327,680 faces, 163,842 vertices):
+//   BM_Resynthesis          c(i) = C c(i−1) + F(i) d(i), i = 1..4, frames from the limit
+//                           tangents of C c(i−1) (MultiresShape::Synthesize)
+//   BM_Refinement           c(4) = C(3) C(2) C(1) C(0) c(0), no details
+//   BM_LimitTessellation    s = LimitPositions(4) c(4): the limit surface at every
+//                           vertex of the finest level
+//   BM_CgalLoopSubdivision  CGAL::Subdivision_method_3::Loop_subdivision, 4 iterations,
+//                           on a Surface_mesh of the same base mesh. The subdivision
+//                           changes its input, so each iteration starts from a fresh copy
+//                           of the base Surface_mesh; the copy is excluded from the
+//                           timing (PauseTiming/ResumeTiming).
+//   BM_HierarchyConstruction  the one-time cost of LoopHierarchy (connectivity and all
+//                           operators of levels 0..4), for scale.
+// All single-threaded. Run with
+//   subdivision_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <cmath>
+
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/subdivision_method_3.h>
+#include <benchmark/benchmark.h>
+
+#include "geometry/icosphere.h"
+#include "geometry/loop_hierarchy.h"
+#include "geometry/multires_shape.h"
+
+namespace subflow::geometry {
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+
+constexpr int kLevels = 4;
+
+TriangleMesh DisplacedIcosphere() {
+  TriangleMesh mesh = MakeIcosphere(3);  // 642 vertices, 1280 faces
+  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v) {
+    const Eigen::RowVector3d p = mesh.V.row(v);
+    mesh.V.row(v) *= 1.0 + 0.1 * std::sin(3.0 * p.x() + 1.0) * std::cos(2.0 * p.y()) +
+                      0.05 * std::sin(5.0 * p.z());
+  }
+  return mesh;
+}
+
+struct Fixture {
+  TriangleMesh base = DisplacedIcosphere();
+  LoopHierarchy hierarchy{base.F, base.vertex_count(), kLevels};
+  MultiresShape shape;
+  Positions finest;
+
+  Fixture() {
+    // A finest level with genuine details at every level: the refined base plus a
+    // high-frequency radial ripple, decomposed by the analysis.
+    Positions fine = hierarchy.Refine(base.V, 0, kLevels);
+    for (Eigen::Index v = 0; v < fine.rows(); ++v)
+      fine.row(v) *= 1.0 + 0.01 * std::sin(40.0 * fine(v, 0)) * std::sin(37.0 * fine(v, 1));
+    shape = MultiresShape::Analyze(hierarchy, fine);
+    finest = shape.Synthesize(hierarchy, kLevels);
+  }
+};
+
+const Fixture& GetFixture() {
+  static const Fixture fixture;
+  return fixture;
+}
+
+void BM_Resynthesis(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  for (auto _ : state) {
+    Positions c = f.shape.Synthesize(f.hierarchy, kLevels);
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.counters["faces"] = f.hierarchy.FaceCount(kLevels);
+}
+BENCHMARK(BM_Resynthesis)->Unit(benchmark::kMillisecond);
+
+void BM_Refinement(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  for (auto _ : state) {
+    Positions c = f.hierarchy.Refine(f.shape.base(), 0, kLevels);
+    benchmark::DoNotOptimize(c.data());
+  }
+}
+BENCHMARK(BM_Refinement)->Unit(benchmark::kMillisecond);
+
+void BM_LimitTessellation(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  for (auto _ : state) {
+    Positions s = MultiplyPoints(f.hierarchy.LimitPositions(kLevels), f.finest);
+    benchmark::DoNotOptimize(s.data());
+  }
+}
+BENCHMARK(BM_LimitTessellation)->Unit(benchmark::kMillisecond);
+
+void BM_CgalLoopSubdivision(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  SurfaceMesh base;
+  std::vector<SurfaceMesh::Vertex_index> vertices;
+  for (Eigen::Index v = 0; v < f.base.V.rows(); ++v)
+    vertices.push_back(base.add_vertex(Kernel::Point_3(f.base.V(v, 0), f.base.V(v, 1), f.base.V(v, 2))));
+  for (Eigen::Index t = 0; t < f.base.F.rows(); ++t)
+    base.add_face(vertices[f.base.F(t, 0)], vertices[f.base.F(t, 1)], vertices[f.base.F(t, 2)]);
+  for (auto _ : state) {
+    state.PauseTiming();
+    SurfaceMesh mesh = base;
+    state.ResumeTiming();
+    CGAL::Subdivision_method_3::Loop_subdivision(mesh, CGAL::parameters::number_of_iterations(kLevels));
+    benchmark::DoNotOptimize(mesh.number_of_faces());
+    state.PauseTiming();
+    if (static_cast<int>(mesh.number_of_faces()) != f.hierarchy.FaceCount(kLevels))
+      state.SkipWithError("CGAL produced a different face count");
+    {
+      SurfaceMesh discard = std::move(mesh);  // destruction excluded from the timing too
+    }
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_CgalLoopSubdivision)->Unit(benchmark::kMillisecond);
+
+void BM_HierarchyConstruction(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  for (auto _ : state) {
+    LoopHierarchy hierarchy(f.base.F, f.base.vertex_count(), kLevels);
+    benchmark::DoNotOptimize(&hierarchy);
+  }
+}
+BENCHMARK(BM_HierarchyConstruction)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace subflow::geometry
+
+BENCHMARK_MAIN();

@@ -1,0 +1,218 @@
+// ExtractIsosurface: CGAL Mesh_3 on a gray-level image domain, surface criteria only.
+// Kept alone in this file because Mesh_3 is the heaviest CGAL package to compile.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Image_3.h>
+#include <CGAL/Labeled_mesh_domain_3.h>
+#include <CGAL/Mesh_complex_3_in_triangulation_3.h>
+#include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_triangulation_3.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Random.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/facets_in_complex_3_to_triangle_mesh.h>
+#include <CGAL/refine_mesh_3.h>
+
+#include "geometry/error.h"
+#include "geometry/isosurface.h"
+#include "geometry/mesh_topology.h"
+
+namespace subflow::geometry {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using MeshDomain = CGAL::Labeled_mesh_domain_3<Kernel>;
+using Triangulation =
+    CGAL::Mesh_triangulation_3<MeshDomain, CGAL::Default, CGAL::Sequential_tag>::type;
+using Complex = CGAL::Mesh_complex_3_in_triangulation_3<Triangulation>;
+using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
+using Point = Kernel::Point_3;
+using SurfaceMesh = CGAL::Surface_mesh<Point>;
+namespace params = CGAL::parameters;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+// Surface points are found by bisection on segments down to this length (voxels).
+constexpr double kIntersectionToleranceVoxels = 1e-3;
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Mesh_3 draws from CGAL's default random generator; fix it for the duration of one
+// extraction and give the caller's generator back afterwards.
+class ScopedDefaultRandom {
+ public:
+  explicit ScopedDefaultRandom(unsigned int seed) : saved_(CGAL::get_default_random()) {
+    CGAL::get_default_random() = CGAL::Random(seed);
+  }
+  ~ScopedDefaultRandom() { CGAL::get_default_random() = saved_; }
+
+ private:
+  CGAL::Random saved_;
+};
+
+// A float CGAL::Image_3 holding `field` (same x-fastest layout, sample (i,j,k) at
+// translation + voxel size·(i,j,k), as in ScalarVolume).
+CGAL::Image_3 MakeImage(const ScalarVolume& field) {
+  const double h = field.spacing;
+  _image* image = ::_createImage(field.nx, field.ny, field.nz, 1, h, h, h, sizeof(float),
+                                 WK_FLOAT, SGN_SIGNED);
+  SUBFLOW_CHECK(image != nullptr, "allocating the CGAL image failed");
+  std::memcpy(image->data, field.values.data(), field.values.size() * sizeof(float));
+  image->tx = static_cast<float>(field.origin.x());
+  image->ty = static_cast<float>(field.origin.y());
+  image->tz = static_cast<float>(field.origin.z());
+  return CGAL::Image_3(image);
+}
+
+// Inserts the surface point of every seed segment into the triangulation, as Mesh_3's
+// own image initialization does, so that every component of the inside gets refined.
+void InsertSeeds(const std::vector<IsosurfaceSeed>& seeds, const MeshDomain& domain,
+                 Complex* c3t3) {
+  Triangulation& tr = c3t3->triangulation();
+  const auto construct_intersection = domain.construct_intersection_object();
+  const auto weighted = tr.geom_traits().construct_weighted_point_3_object();
+  for (const IsosurfaceSeed& seed : seeds) {
+    const Kernel::Segment_3 segment(Point(seed.inside.x(), seed.inside.y(), seed.inside.z()),
+                                    Point(seed.outside.x(), seed.outside.y(), seed.outside.z()));
+    const MeshDomain::Intersection intersection = construct_intersection(segment);
+    if (std::get<2>(intersection) == 0) continue;  // no crossing found (cannot happen)
+    const Triangulation::Vertex_handle v = tr.insert(weighted(std::get<0>(intersection)));
+    if (v == Triangulation::Vertex_handle()) continue;  // hidden point
+    c3t3->set_dimension(v, 2);
+    c3t3->set_index(v, std::get<1>(intersection));
+  }
+  if (tr.dimension() == 3) return;
+  // Seeds all coplanar (a flat object): add the domain's own random surface points.
+  std::vector<std::pair<Point, MeshDomain::Index>> points;
+  domain.construct_initial_points_object()(std::back_inserter(points), 20);
+  for (const auto& [point, index] : points) {
+    const Triangulation::Vertex_handle v = tr.insert(weighted(point));
+    if (v == Triangulation::Vertex_handle()) continue;
+    c3t3->set_dimension(v, 2);
+    c3t3->set_index(v, index);
+  }
+}
+
+// The boundary facets of the complex as a closed, outward-oriented 2-manifold.
+TriangleMesh ExtractBoundary(const Complex& c3t3, const std::string& source) {
+  std::vector<Point> points;
+  std::vector<std::array<std::size_t, 3>> triangles;
+  // Facets are oriented with the normal pointing from subdomain 1 (inside) to 0.
+  CGAL::Mesh_3::internal::facets_in_complex_3_to_triangle_soup(c3t3, points, triangles);
+  if (triangles.empty())
+    ThrowError(source, "surface", "Mesh_3 produced no surface triangle");
+  if (!PMP::is_polygon_soup_a_polygon_mesh(triangles)) {
+    const size_t point_count = points.size();
+    PMP::orient_polygon_soup(points, triangles);
+    // orient_polygon_soup duplicates the vertices where the surface is not a 2-manifold.
+    if (points.size() != point_count)
+      ThrowError(source, "surface",
+                 "the extracted surface has " + std::to_string(points.size() - point_count) +
+                     " non-manifold vertices; try a smaller facet_size_voxels");
+  }
+  SurfaceMesh mesh;
+  PMP::polygon_soup_to_polygon_mesh(points, triangles, mesh);
+  if (!CGAL::is_closed(mesh))
+    ThrowError(source, "surface",
+               "the extracted surface is not closed; try a smaller facet_size_voxels or a "
+               "larger max_vertex_count");
+  // Restricted Delaunay facets never intersect, so the precondition (closed, no
+  // self-intersection) holds; this also orients nested components (cavities) correctly.
+  PMP::orient_to_bound_a_volume(mesh);
+
+  TriangleMesh result;
+  result.V.resize(mesh.number_of_vertices(), 3);
+  for (const SurfaceMesh::Vertex_index v : mesh.vertices()) {
+    const Point& p = mesh.point(v);
+    result.V.row(static_cast<int>(v)) << p.x(), p.y(), p.z();
+  }
+  result.F.resize(mesh.number_of_faces(), 3);
+  int row = 0;
+  for (const SurfaceMesh::Face_index f : mesh.faces()) {
+    int k = 0;
+    for (const SurfaceMesh::Vertex_index v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+      result.F(row, k++) = static_cast<int>(v);
+    ++row;
+  }
+  return result;
+}
+
+}  // namespace
+
+TriangleMesh ExtractIsosurface(const ScalarVolume& volume, const IsosurfaceOptions& options,
+                               IsosurfaceSummary* summary, const std::string& source) {
+  options.Check();
+  CheckScalarVolume(volume, source);
+  const double iso = options.iso_value;
+  if (std::all_of(volume.values.begin(), volume.values.end(), [&](float x) { return x > iso; }))
+    ThrowError(source, "values",
+               "every voxel is occupied (value > iso_value " + std::to_string(iso) +
+                   "): the volume does not enclose the object");
+
+  IsosurfaceSummary stats;
+  auto start = std::chrono::steady_clock::now();
+  const double sigma = options.smoothing_sigma_voxels;
+  const int blur_reach = sigma > 0.0 ? static_cast<int>(std::ceil(3.0 * sigma)) + 1 : 1;
+  const ScalarVolume field =
+      PadAndSmoothVolume(volume, std::max(options.padding_voxels, blur_reach), sigma);
+  int outside_component_count = 0;
+  const std::vector<IsosurfaceSeed> seeds =
+      FindIsosurfaceSeeds(field, iso, &stats.component_count, &outside_component_count);
+  // The padding makes the grid border one outside component; the others are cavities.
+  stats.cavity_count = std::max(0, outside_component_count - 1);
+  if (stats.component_count == 0)
+    ThrowError(source, "values",
+               "no voxel is occupied (no value > iso_value " + std::to_string(iso) +
+                   " after smoothing with σ = " + std::to_string(sigma) +
+                   " voxels): the volume is empty or its objects are thinner than the blur");
+  stats.prepare_seconds = SecondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  const ScopedDefaultRandom scoped_random(options.random_seed);
+  CGAL::Random domain_random(options.random_seed);
+  const CGAL::Image_3 image = MakeImage(field);
+  // Mesh_3 measures the bisection tolerance relative to the diagonal of the image's
+  // bounding box, which it enlarges by one world unit on every side.
+  const double h = field.spacing;
+  const double diagonal = std::sqrt(std::pow(field.nx * h + 2.0, 2) +
+                                    std::pow(field.ny * h + 2.0, 2) +
+                                    std::pow(field.nz * h + 2.0, 2));
+  const MeshDomain domain = MeshDomain::create_gray_image_mesh_domain(
+      image, params::iso_value = static_cast<float>(iso), params::value_outside = 0.0f,
+      params::relative_error_bound = kIntersectionToleranceVoxels * h / diagonal,
+      params::p_rng = &domain_random);
+  const Criteria criteria(params::facet_angle = options.facet_angle_degrees,
+                          params::facet_size = options.facet_size_voxels * h,
+                          params::facet_distance = options.facet_distance_voxels * h);
+  Complex c3t3;
+  InsertSeeds(seeds, domain, &c3t3);
+  CGAL::refine_mesh_3(
+      c3t3, domain, criteria, params::no_perturb(), params::no_exude(), params::manifold(),
+      params::no_reset_c3t3(),
+      params::mesh_3_options(params::maximal_number_of_vertices =
+                                 static_cast<std::size_t>(options.max_vertex_count)));
+  stats.mesh_seconds = SecondsSince(start);
+
+  start = std::chrono::steady_clock::now();
+  TriangleMesh mesh = ExtractBoundary(c3t3, source);
+  // The one check that matters downstream: an oriented, closed 2-manifold (throws if not).
+  const MeshTopology topology(mesh.F, mesh.vertex_count(), source + " (iso-surface)");
+  if (!topology.IsClosed())
+    ThrowError(source, "surface", "the extracted surface has boundary edges");
+  stats.vertex_count = mesh.vertex_count();
+  stats.face_count = mesh.face_count();
+  stats.extract_seconds = SecondsSince(start);
+  if (summary != nullptr) *summary = stats;
+  return mesh;
+}
+
+}  // namespace subflow::geometry

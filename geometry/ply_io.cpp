@@ -1,0 +1,541 @@
+#include "geometry/ply_io.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <set>
+#include <string_view>
+
+#include <spdlog/spdlog.h>
+
+#include "geometry/error.h"
+
+namespace subflow::geometry {
+namespace {
+
+enum class ScalarType { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+struct ScalarTypeName {
+  const char* name;
+  ScalarType type;
+};
+constexpr ScalarTypeName kScalarTypeNames[] = {
+    {"char", ScalarType::kInt8},       {"int8", ScalarType::kInt8},
+    {"uchar", ScalarType::kUint8},     {"uint8", ScalarType::kUint8},
+    {"short", ScalarType::kInt16},     {"int16", ScalarType::kInt16},
+    {"ushort", ScalarType::kUint16},   {"uint16", ScalarType::kUint16},
+    {"int", ScalarType::kInt32},       {"int32", ScalarType::kInt32},
+    {"uint", ScalarType::kUint32},     {"uint32", ScalarType::kUint32},
+    {"float", ScalarType::kFloat32},   {"float32", ScalarType::kFloat32},
+    {"double", ScalarType::kFloat64},  {"float64", ScalarType::kFloat64}};
+
+int ScalarSize(ScalarType type) {
+  switch (type) {
+    case ScalarType::kInt8: case ScalarType::kUint8: return 1;
+    case ScalarType::kInt16: case ScalarType::kUint16: return 2;
+    case ScalarType::kInt32: case ScalarType::kUint32: case ScalarType::kFloat32: return 4;
+    case ScalarType::kFloat64: return 8;
+  }
+  return 0;
+}
+
+bool IsInteger(ScalarType type) {
+  return type != ScalarType::kFloat32 && type != ScalarType::kFloat64;
+}
+
+bool HostIsBigEndian() {
+  const std::uint16_t one = 1;
+  unsigned char first;
+  std::memcpy(&first, &one, 1);
+  return first == 0;
+}
+
+enum class Encoding { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
+
+struct Property {
+  std::string name;
+  ScalarType type = ScalarType::kFloat32;  // the value type, or the item type of a list
+  bool is_list = false;
+  ScalarType count_type = ScalarType::kUint8;
+};
+
+struct Element {
+  std::string name;
+  long long count = 0;
+  std::vector<Property> properties;
+};
+
+struct Header {
+  Encoding encoding = Encoding::kAscii;
+  std::vector<Element> elements;
+  size_t body_offset = 0;  // first byte after "end_header\n"
+  int body_line = 0;       // 1-based line number of the first body line (ascii)
+};
+
+// The line starting at *pos without its "\n" or "\r\n"; false at the end of `bytes`.
+bool NextLine(const std::string& bytes, size_t* pos, std::string_view* line) {
+  if (*pos >= bytes.size()) return false;
+  size_t end = bytes.find('\n', *pos);
+  const size_t next = end == std::string::npos ? bytes.size() : end + 1;
+  if (end == std::string::npos) end = bytes.size();
+  if (end > *pos && bytes[end - 1] == '\r') --end;
+  *line = std::string_view(bytes).substr(*pos, end - *pos);
+  *pos = next;
+  return true;
+}
+
+std::vector<std::string_view> Tokens(std::string_view line) {
+  std::vector<std::string_view> tokens;
+  size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+    size_t j = i;
+    while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
+    if (j > i) tokens.push_back(line.substr(i, j - i));
+    i = j;
+  }
+  return tokens;
+}
+
+bool ParseScalarType(std::string_view name, ScalarType* type) {
+  for (const ScalarTypeName& entry : kScalarTypeNames)
+    if (name == entry.name) {
+      *type = entry.type;
+      return true;
+    }
+  return false;
+}
+
+std::string ScalarTypeError(std::string_view name) {
+  return "unknown type \"" + std::string(name) +
+         "\" (expected char, uchar, short, ushort, int, uint, float, double or "
+         "int8, uint8, int16, uint16, int32, uint32, float32, float64)";
+}
+
+Header ParseHeader(const std::string& bytes, const std::string& source) {
+  size_t pos = 0;
+  std::string_view line;
+  if (!NextLine(bytes, &pos, &line) || Tokens(line).size() != 1 || Tokens(line)[0] != "ply")
+    ThrowError(source, "header line 1", "expected the magic word \"ply\" (not a PLY file)");
+  Header header;
+  bool have_format = false;
+  int line_number = 1;
+  while (true) {
+    if (!NextLine(bytes, &pos, &line))
+      ThrowError(source, "header", "the file ends before \"end_header\"");
+    ++line_number;
+    const std::string where = "header line " + std::to_string(line_number);
+    const std::vector<std::string_view> tokens = Tokens(line);
+    if (tokens.empty()) continue;
+    const std::string_view keyword = tokens[0];
+    if (keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword == "end_header") break;
+    if (keyword == "format") {
+      if (tokens.size() != 3)
+        ThrowError(source, where, "expected \"format <ascii|binary_little_endian|binary_big_endian> 1.0\"");
+      if (tokens[1] == "ascii") header.encoding = Encoding::kAscii;
+      else if (tokens[1] == "binary_little_endian") header.encoding = Encoding::kBinaryLittleEndian;
+      else if (tokens[1] == "binary_big_endian") header.encoding = Encoding::kBinaryBigEndian;
+      else
+        ThrowError(source, where, "unsupported format \"" + std::string(tokens[1]) +
+                                      "\" (expected ascii, binary_little_endian or binary_big_endian)");
+      if (tokens[2] != "1.0")
+        ThrowError(source, where, "unsupported version \"" + std::string(tokens[2]) + "\" (expected 1.0)");
+      have_format = true;
+    } else if (keyword == "element") {
+      Element element;
+      long long count = -1;
+      if (tokens.size() == 3) {
+        const auto [end, ec] = std::from_chars(tokens[2].data(), tokens[2].data() + tokens[2].size(), count);
+        if (ec != std::errc() || end != tokens[2].data() + tokens[2].size()) count = -1;
+      }
+      if (count < 0 || count > std::numeric_limits<int>::max())
+        ThrowError(source, where, "expected \"element <name> <count>\" with a count in [0, 2^31)");
+      element.name = std::string(tokens[1]);
+      element.count = count;
+      for (const Element& other : header.elements)
+        if (other.name == element.name)
+          ThrowError(source, where, "element \"" + element.name + "\" is declared twice");
+      header.elements.push_back(element);
+    } else if (keyword == "property") {
+      if (header.elements.empty())
+        ThrowError(source, where, "property declared before any element");
+      Property property;
+      if (tokens.size() == 3 && tokens[1] != "list") {
+        if (!ParseScalarType(tokens[1], &property.type)) ThrowError(source, where, ScalarTypeError(tokens[1]));
+        property.name = std::string(tokens[2]);
+      } else if (tokens.size() == 5 && tokens[1] == "list") {
+        property.is_list = true;
+        if (!ParseScalarType(tokens[2], &property.count_type))
+          ThrowError(source, where, ScalarTypeError(tokens[2]));
+        if (!IsInteger(property.count_type))
+          ThrowError(source, where, "list count type must be an integer type, not " + std::string(tokens[2]));
+        if (!ParseScalarType(tokens[3], &property.type)) ThrowError(source, where, ScalarTypeError(tokens[3]));
+        property.name = std::string(tokens[4]);
+      } else {
+        ThrowError(source, where,
+                   "expected \"property <type> <name>\" or \"property list <count type> <item type> <name>\"");
+      }
+      header.elements.back().properties.push_back(property);
+    } else {
+      ThrowError(source, where,
+                 "unexpected \"" + std::string(keyword) +
+                     "\" (expected format, element, property, comment, obj_info or end_header)");
+    }
+  }
+  if (!have_format) ThrowError(source, "header", "no \"format\" line");
+  header.body_offset = pos;
+  header.body_line = line_number + 1;
+  return header;
+}
+
+// Element instances in ascii: one line each, tokens in property order.
+class AsciiBody {
+ public:
+  AsciiBody(const std::string& bytes, const Header& header, const std::string& source)
+      : bytes_(bytes), pos_(header.body_offset), line_number_(header.body_line - 1), source_(source) {}
+
+  void Begin(const Element& element, long long index) {
+    element_ = &element;
+    index_ = index;
+    std::string_view line;
+    do {
+      if (!NextLine(bytes_, &pos_, &line))
+        ThrowError(source_, element.name + " " + std::to_string(index),
+                   "the file ends after " + std::to_string(index) + " of the " +
+                       std::to_string(element.count) + " " + element.name +
+                       " lines the header announces");
+      ++line_number_;
+      tokens_ = Tokens(line);
+    } while (tokens_.empty());
+    next_token_ = 0;
+  }
+
+  double Scalar(ScalarType type, const std::string& property) {
+    if (next_token_ >= tokens_.size())
+      ThrowError(source_, Where(), "the line ends before property \"" + property + "\"");
+    std::string_view token = tokens_[next_token_++];
+    if (!token.empty() && token[0] == '+') token.remove_prefix(1);  // from_chars rejects '+'
+    const char* end = token.data() + token.size();
+    if (IsInteger(type)) {
+      long long value = 0;
+      const auto result = std::from_chars(token.data(), end, value);
+      if (result.ec != std::errc() || result.ptr != end)
+        ThrowError(source_, Where(), "property \"" + property + "\": \"" + std::string(token) +
+                                         "\" is not an integer");
+      return static_cast<double>(value);
+    }
+    double value = 0.0;
+    const auto result = std::from_chars(token.data(), end, value);
+    if (result.ec == std::errc::result_out_of_range) return std::copysign(HUGE_VAL, token[0] == '-' ? -1 : 1);
+    if (result.ec != std::errc() || result.ptr != end)
+      ThrowError(source_, Where(), "property \"" + property + "\": \"" + std::string(token) +
+                                       "\" is not a number");
+    // A float property holds a float: round as a binary file would have stored it.
+    return type == ScalarType::kFloat32 ? static_cast<double>(static_cast<float>(value)) : value;
+  }
+
+  void End() {
+    if (next_token_ != tokens_.size())
+      ThrowError(source_, Where(), "the line has " + std::to_string(tokens_.size()) +
+                                       " values, more than the header's properties describe");
+  }
+
+  void Finish() {
+    std::string_view line;
+    while (NextLine(bytes_, &pos_, &line)) {
+      ++line_number_;
+      if (!Tokens(line).empty())
+        ThrowError(source_, "line " + std::to_string(line_number_),
+                   "data after the last element (the header's element counts do not match the data)");
+    }
+  }
+
+  std::string Where() const {
+    return element_->name + " " + std::to_string(index_) + " (line " + std::to_string(line_number_) + ")";
+  }
+
+ private:
+  const std::string& bytes_;
+  size_t pos_;
+  int line_number_;
+  const std::string& source_;
+  const Element* element_ = nullptr;
+  long long index_ = 0;
+  std::vector<std::string_view> tokens_;
+  size_t next_token_ = 0;
+};
+
+// Element instances in binary: packed values, in the file's byte order.
+class BinaryBody {
+ public:
+  BinaryBody(const std::string& bytes, const Header& header, const std::string& source)
+      : bytes_(bytes), pos_(header.body_offset), source_(source),
+        swap_((header.encoding == Encoding::kBinaryBigEndian) != HostIsBigEndian()) {}
+
+  void Begin(const Element& element, long long index) {
+    element_ = &element;
+    index_ = index;
+  }
+
+  double Scalar(ScalarType type, const std::string& property) {
+    const int size = ScalarSize(type);
+    if (pos_ + size > bytes_.size())
+      ThrowError(source_, Where(),
+                 "truncated binary data: the file ends inside property \"" + property + "\" (the header announces " +
+                     std::to_string(element_->count) + " " + element_->name + " elements)");
+    unsigned char raw[8];
+    std::memcpy(raw, bytes_.data() + pos_, size);
+    pos_ += size;
+    if (swap_) std::reverse(raw, raw + size);
+    switch (type) {
+      case ScalarType::kInt8: return Load<std::int8_t>(raw);
+      case ScalarType::kUint8: return Load<std::uint8_t>(raw);
+      case ScalarType::kInt16: return Load<std::int16_t>(raw);
+      case ScalarType::kUint16: return Load<std::uint16_t>(raw);
+      case ScalarType::kInt32: return Load<std::int32_t>(raw);
+      case ScalarType::kUint32: return Load<std::uint32_t>(raw);
+      case ScalarType::kFloat32: return Load<float>(raw);
+      case ScalarType::kFloat64: return Load<double>(raw);
+    }
+    return 0.0;
+  }
+
+  void End() {}
+
+  void Finish() {
+    if (pos_ != bytes_.size())
+      spdlog::warn("{}: {} bytes after the last element are ignored", source_, bytes_.size() - pos_);
+  }
+
+  std::string Where() const { return element_->name + " " + std::to_string(index_); }
+
+ private:
+  template <class T>
+  static double Load(const unsigned char* raw) {
+    T value;
+    std::memcpy(&value, raw, sizeof(T));
+    return static_cast<double>(value);
+  }
+
+  const std::string& bytes_;
+  size_t pos_;
+  const std::string& source_;
+  bool swap_;
+  const Element* element_ = nullptr;
+  long long index_ = 0;
+};
+
+int FindProperty(const Element& element, std::initializer_list<const char*> names) {
+  for (size_t p = 0; p < element.properties.size(); ++p)
+    for (const char* name : names)
+      if (element.properties[p].name == name) return static_cast<int>(p);
+  return -1;
+}
+
+template <class Body>
+TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes,
+                      const std::string& source, VertexProperties* properties) {
+  const Element* vertex = nullptr;
+  const Element* face = nullptr;
+  for (const Element& element : header.elements) {
+    if (element.name == "vertex") vertex = &element;
+    if (element.name == "face") face = &element;
+    // Every instance takes at least one byte, so a larger count cannot be honest; this
+    // rejects truncated files before allocating what their header promises.
+    if (!element.properties.empty() && element.count > static_cast<long long>(bytes.size() - header.body_offset))
+      ThrowError(source, "element " + element.name,
+                 "the header announces " + std::to_string(element.count) + " elements but only " +
+                     std::to_string(bytes.size() - header.body_offset) + " bytes of data follow (truncated file)");
+  }
+  if (!vertex) ThrowError(source, "header", "no \"vertex\" element");
+  if (!face) ThrowError(source, "header", "no \"face\" element (expected a triangle mesh)");
+  if (vertex->count == 0) ThrowError(source, "element vertex", "count is 0 (expected a non-empty mesh)");
+  if (face->count == 0) ThrowError(source, "element face", "count is 0 (expected a non-empty mesh)");
+
+  // Roles of the vertex properties: coordinate axis, extra column, or skipped list.
+  std::vector<int> vertex_role(vertex->properties.size(), -1);  // 0..2 axis, 3+k extra k, -1 skip
+  std::vector<std::string> extra_names;
+  const char* kAxes[3] = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    const int p = FindProperty(*vertex, {kAxes[axis]});
+    if (p < 0 || vertex->properties[p].is_list)
+      ThrowError(source, "element vertex", std::string("expected a scalar property \"") + kAxes[axis] + "\"");
+    vertex_role[p] = axis;
+  }
+  for (size_t p = 0; p < vertex->properties.size(); ++p)
+    if (vertex_role[p] < 0 && !vertex->properties[p].is_list) {
+      vertex_role[p] = 3 + static_cast<int>(extra_names.size());
+      extra_names.push_back(vertex->properties[p].name);
+    }
+  const int index_property = FindProperty(*face, {"vertex_indices", "vertex_index"});
+  if (index_property < 0 || !face->properties[index_property].is_list ||
+      !IsInteger(face->properties[index_property].type))
+    ThrowError(source, "element face",
+               "expected an integer list property \"vertex_indices\" (or \"vertex_index\")");
+
+  TriangleMesh mesh;
+  mesh.V.resize(vertex->count, 3);
+  mesh.F.resize(face->count, 3);
+  Eigen::MatrixXd extra(vertex->count, static_cast<Eigen::Index>(extra_names.size()));
+  for (const Element& element : header.elements) {
+    const bool is_vertex = &element == vertex;
+    const bool is_face = &element == face;
+    for (long long i = 0; i < element.count; ++i) {
+      body.Begin(element, i);
+      for (size_t p = 0; p < element.properties.size(); ++p) {
+        const Property& property = element.properties[p];
+        if (!property.is_list) {
+          const double value = body.Scalar(property.type, property.name);
+          if (is_vertex && vertex_role[p] >= 0) {
+            if (vertex_role[p] < 3) mesh.V(i, vertex_role[p]) = value;
+            else extra(i, vertex_role[p] - 3) = value;
+          }
+          continue;
+        }
+        const double length = body.Scalar(property.count_type, property.name + " (list length)");
+        if (length < 0) ThrowError(source, body.Where(), "negative list length in \"" + property.name + "\"");
+        if (is_face && static_cast<int>(p) == index_property) {
+          if (length != 3)
+            ThrowError(source, body.Where(),
+                       "has " + std::to_string(static_cast<long long>(length)) +
+                           " vertices; expected 3 (subflow reads triangle meshes only)");
+          for (int k = 0; k < 3; ++k) {
+            const double index = body.Scalar(property.type, property.name);
+            if (index < 0 || index >= static_cast<double>(vertex->count))
+              ThrowError(source, body.Where(),
+                         "vertex index " + std::to_string(static_cast<long long>(index)) +
+                             " out of range [0, " + std::to_string(vertex->count) + ")");
+            mesh.F(i, k) = static_cast<int>(index);
+          }
+        } else {
+          for (long long k = 0; k < static_cast<long long>(length); ++k) body.Scalar(property.type, property.name);
+        }
+      }
+      body.End();
+      if (is_vertex) {
+        for (int axis = 0; axis < 3; ++axis)
+          if (!std::isfinite(mesh.V(i, axis)))
+            ThrowError(source, body.Where(),
+                       std::string("coordinate ") + kAxes[axis] + " is " +
+                           (std::isnan(mesh.V(i, axis)) ? "NaN" : "infinite") + " (expected a finite number)");
+      }
+    }
+  }
+  body.Finish();
+
+  if (properties) {
+    properties->names = extra_names;
+    properties->values.clear();
+    for (size_t k = 0; k < extra_names.size(); ++k) properties->values[extra_names[k]] = extra.col(k);
+  }
+  return mesh;
+}
+
+void AppendFloat(std::string* buffer, float value, bool swap) {
+  unsigned char raw[4];
+  std::memcpy(raw, &value, 4);
+  if (swap) std::reverse(raw, raw + 4);
+  buffer->append(reinterpret_cast<const char*>(raw), 4);
+}
+
+void AppendInt32(std::string* buffer, std::int32_t value, bool swap) {
+  unsigned char raw[4];
+  std::memcpy(raw, &value, 4);
+  if (swap) std::reverse(raw, raw + 4);
+  buffer->append(reinterpret_cast<const char*>(raw), 4);
+}
+
+}  // namespace
+
+TriangleMesh ParsePly(const std::string& bytes, const std::string& source, VertexProperties* properties) {
+  const Header header = ParseHeader(bytes, source);
+  if (header.encoding == Encoding::kAscii) {
+    AsciiBody body(bytes, header, source);
+    return ReadBody(body, header, bytes, source, properties);
+  }
+  BinaryBody body(bytes, header, source);
+  return ReadBody(body, header, bytes, source, properties);
+}
+
+std::vector<std::string> PropertyWriteOrder(const VertexProperties& properties, int vertex_count,
+                                            const std::string& source) {
+  std::vector<std::string> names = properties.names;
+  if (names.empty())
+    for (const auto& entry : properties.values) names.push_back(entry.first);
+  std::set<std::string> seen;
+  for (const std::string& name : names) {
+    const std::string field = "vertex property \"" + name + "\"";
+    const auto it = properties.values.find(name);
+    if (it == properties.values.end()) ThrowError(source, field, "listed in names but has no values");
+    if (it->second.size() != vertex_count)
+      ThrowError(source, field, "has " + std::to_string(it->second.size()) + " values; expected one per vertex (" +
+                                    std::to_string(vertex_count) + ")");
+    if (name == "x" || name == "y" || name == "z") ThrowError(source, field, "collides with a coordinate");
+    if (name.empty() || name.find_first_of(" \t\r\n") != std::string::npos)
+      ThrowError(source, field, "expected a non-empty name without white space");
+    if (!seen.insert(name).second) ThrowError(source, field, "listed twice in names");
+  }
+  if (seen.size() != properties.values.size())
+    ThrowError(source, "vertex properties", "values are given for properties missing from names");
+  return names;
+}
+
+void WritePly(std::ostream& out, const TriangleMesh& mesh, const VertexProperties* properties,
+              PlyFormat format, const std::string& source) {
+  const int n = mesh.vertex_count();
+  const int m = mesh.face_count();
+  const std::vector<std::string> names =
+      properties ? PropertyWriteOrder(*properties, n, source) : std::vector<std::string>{};
+  std::vector<const Eigen::VectorXd*> columns;
+  for (const std::string& name : names) columns.push_back(&properties->values.at(name));
+  for (int v = 0; v < n; ++v)
+    if (!mesh.V.row(v).allFinite())
+      ThrowError(source, "vertex " + std::to_string(v), "non-finite coordinate (refusing to write it)");
+
+  std::string text = "ply\nformat ";
+  text += format == PlyFormat::kAscii ? "ascii 1.0\n" : "binary_little_endian 1.0\n";
+  text += "comment written by subflow\n";
+  text += "element vertex " + std::to_string(n) + "\n";
+  text += "property float x\nproperty float y\nproperty float z\n";
+  for (const std::string& name : names) text += "property float " + name + "\n";
+  text += "element face " + std::to_string(m) + "\n";
+  text += "property list uchar int vertex_indices\nend_header\n";
+
+  if (format == PlyFormat::kAscii) {
+    char number[32];
+    for (int v = 0; v < n; ++v) {
+      for (int axis = 0; axis < 3; ++axis) {
+        std::snprintf(number, sizeof(number), axis ? " %.9g" : "%.9g", static_cast<double>(static_cast<float>(mesh.V(v, axis))));
+        text += number;
+      }
+      for (const Eigen::VectorXd* column : columns) {
+        std::snprintf(number, sizeof(number), " %.9g", static_cast<double>(static_cast<float>((*column)(v))));
+        text += number;
+      }
+      text += '\n';
+    }
+    for (int f = 0; f < m; ++f)
+      text += "3 " + std::to_string(mesh.F(f, 0)) + " " + std::to_string(mesh.F(f, 1)) + " " +
+              std::to_string(mesh.F(f, 2)) + "\n";
+  } else {
+    const bool swap = HostIsBigEndian();
+    text.reserve(text.size() + static_cast<size_t>(n) * 4 * (3 + names.size()) + static_cast<size_t>(m) * 13);
+    for (int v = 0; v < n; ++v) {
+      for (int axis = 0; axis < 3; ++axis) AppendFloat(&text, static_cast<float>(mesh.V(v, axis)), swap);
+      for (const Eigen::VectorXd* column : columns) AppendFloat(&text, static_cast<float>((*column)(v)), swap);
+    }
+    for (int f = 0; f < m; ++f) {
+      text += static_cast<char>(3);
+      for (int k = 0; k < 3; ++k) AppendInt32(&text, mesh.F(f, k), swap);
+    }
+  }
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+}
+
+}  // namespace subflow::geometry

@@ -1,0 +1,393 @@
+#include "solver/normal_flow_solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/IterativeLinearSolvers>
+#include <tbb/parallel_for.h>
+
+#include "geometry/error.h"
+#include "geometry/local_frames.h"
+#include "geometry/loop_operators.h"
+
+namespace subflow::solver {
+namespace {
+
+using geometry::Positions;
+using Sparse = Eigen::SparseMatrix<double>;
+using VectorMap = Eigen::Map<Eigen::VectorXd>;
+using ConstVectorMap = Eigen::Map<const Eigen::VectorXd>;
+
+// A ⊗ I3 for a scalar sparse matrix A: entry (r, c) becomes the 3×3 block at (3r, 3c).
+template <typename Matrix>
+Sparse Kron3(const Matrix& A) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(3 * static_cast<std::size_t>(A.nonZeros()));
+  for (int outer = 0; outer < A.outerSize(); ++outer)
+    for (typename Matrix::InnerIterator it(A, outer); it; ++it)
+      for (int a = 0; a < 3; ++a)
+        triplets.emplace_back(3 * static_cast<int>(it.row()) + a, 3 * static_cast<int>(it.col()) + a,
+                              it.value());
+  Sparse result(3 * A.rows(), 3 * A.cols());
+  result.setFromTriplets(triplets.begin(), triplets.end());
+  return result;
+}
+
+double Tukey(double x) {
+  if (std::abs(x) >= 1.0) return 0.0;
+  const double t = 1.0 - x * x;
+  return t * t;
+}
+
+double MedianAbs(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  for (double& v : values) v = std::abs(v);
+  const std::size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+}  // namespace
+
+void NormalFlowSolverOptions::Check() const {
+  auto finite_nonnegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!finite_nonnegative(smoothness))
+    ThrowError("normal flow solver", "smoothness", "expected a finite value ≥ 0");
+  if (!finite_nonnegative(detail_damping))
+    ThrowError("normal flow solver", "detail_damping", "expected a finite value ≥ 0");
+  if (coarsest_level < 0)
+    ThrowError("normal flow solver", "coarsest_level", "expected ≥ 0");
+  if (finest_level >= 0 && finest_level < coarsest_level)
+    ThrowError("normal flow solver", "finest_level", "expected −1 or ≥ coarsest_level");
+  if (reweighting_iterations < 0 || reweighting_iterations > 50)
+    ThrowError("normal flow solver", "reweighting_iterations", "expected 0..50");
+  if (!std::isfinite(robust_threshold) || robust_threshold <= 0.0)
+    ThrowError("normal flow solver", "robust_threshold", "expected a finite value > 0");
+  if (collinearity_min_cameras < 3)
+    ThrowError("normal flow solver", "collinearity_min_cameras",
+               "expected ≥ 3 (two planes always intersect in a line)");
+  if (!std::isfinite(cg_tolerance) || cg_tolerance <= 0.0 || cg_tolerance >= 1.0)
+    ThrowError("normal flow solver", "cg_tolerance", "expected a value in (0, 1)");
+  if (cg_max_iterations < 1)
+    ThrowError("normal flow solver", "cg_max_iterations", "expected ≥ 1");
+}
+
+NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
+                                   const geometry::SparseMatrix& sample_limit,
+                                   const Positions& reference_control,
+                                   const NormalFlowSolverOptions& options)
+    : hierarchy_(&hierarchy), options_(options) {
+  options_.Check();
+  n_ = hierarchy.finest_level();
+  lo_ = options_.coarsest_level;
+  hi_ = options_.finest_level < 0 ? n_ : options_.finest_level;
+  if (hi_ > n_ || lo_ > n_)
+    ThrowError("normal flow solver", "levels",
+               "coarsest/finest level beyond the hierarchy's finest level " + std::to_string(n_));
+  const int vertices = hierarchy.VertexCount(n_);
+  if (sample_limit.cols() != vertices)
+    ThrowError("normal flow solver", "sample limit matrix",
+               std::to_string(sample_limit.cols()) + " columns, expected #V(n) = " +
+                   std::to_string(vertices));
+  if (reference_control.rows() != vertices)
+    ThrowError("normal flow solver", "reference control points",
+               std::to_string(reference_control.rows()) + " rows, expected " +
+                   std::to_string(vertices));
+  limit_ = sample_limit;
+  limit_.makeCompressed();
+
+  // Pattern of Lᵀ L (all-ones values: no cancellation) and, per sample, the entry of each
+  // pair of its stencil's columns.
+  Sparse ones = limit_;
+  for (int k = 0; k < ones.outerSize(); ++k)
+    for (Sparse::InnerIterator it(ones, k); it; ++it) it.valueRef() = 1.0;
+  pattern_ = Sparse(ones.transpose() * ones);
+  // A transposed copy sorts the inner indices (the pair lookup below bisects them).
+  const Sparse pattern_transposed = pattern_.transpose();
+  pattern_ = pattern_transposed.transpose();
+  pattern_.makeCompressed();
+  const int samples = static_cast<int>(limit_.rows());
+  sample_pair_offset_.assign(samples + 1, 0);
+  for (int s = 0; s < samples; ++s) {
+    const int k = limit_.outerIndexPtr()[s + 1] - limit_.outerIndexPtr()[s];
+    sample_pair_offset_[s + 1] = sample_pair_offset_[s] + k * k;
+  }
+  pair_entry_.resize(sample_pair_offset_.back());
+  const int* outer = pattern_.outerIndexPtr();
+  const int* inner = pattern_.innerIndexPtr();
+  tbb::parallel_for(0, samples, [&](int s) {
+    const int begin = limit_.outerIndexPtr()[s], k = limit_.outerIndexPtr()[s + 1] - begin;
+    const int* columns = limit_.innerIndexPtr() + begin;
+    for (int p = 0; p < k; ++p)
+      for (int q = 0; q < k; ++q) {
+        const int* first = inner + outer[columns[q]];
+        const int* last = inner + outer[columns[q] + 1];
+        const int* found = std::lower_bound(first, last, columns[p]);
+        SUBFLOW_CHECK(found != last && *found == columns[p], "LᵀL pattern misses a pair");
+        pair_entry_[sample_pair_offset_[s] + p * k + q] = static_cast<int>(found - inner);
+      }
+  });
+
+  // Prolongations P_i = C(n−1)⋯C(i), Laplacian Gram matrices, length scales.
+  prolongation3_.resize(n_ + 1);
+  smoothness3_.resize(n_ + 1);
+  length_ratio4_.assign(n_ + 1, 0.0);
+  geometry::SparseMatrix P(vertices, vertices);
+  P.setIdentity();
+  const Eigen::RowVector3d centroid = reference_control.colwise().mean();
+  const double radius =
+      std::sqrt((reference_control.rowwise() - centroid).rowwise().squaredNorm().mean());
+  const geometry::MeshTopology& finest = hierarchy.Topology(n_);
+  double edge_sum = 0.0;
+  for (int e = 0; e < finest.edge_count(); ++e)
+    edge_sum += (reference_control.row(finest.EdgeVertex(e, 0)) -
+                 reference_control.row(finest.EdgeVertex(e, 1))).norm();
+  const double finest_edge = edge_sum / std::max(1, finest.edge_count());
+  if (!(radius > 0.0) || !(finest_edge > 0.0))
+    ThrowError("normal flow solver", "reference control points", "are degenerate (zero size)");
+  for (int level = n_; level >= lo_; --level) {
+    if (level < n_) P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
+    if (level <= hi_) {
+      prolongation3_[level] = Kron3(P);
+      const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(hierarchy.Topology(level));
+      smoothness3_[level] = Kron3(geometry::SparseMatrix(U.transpose() * U));
+      length_ratio4_[level] = std::pow(radius / (finest_edge * std::ldexp(1.0, n_ - level)), 4);
+    }
+  }
+}
+
+Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
+  SUBFLOW_CHECK(displacement.rows() == limit_.cols(), "displacement of another level");
+  return limit_ * displacement;
+}
+
+Eigen::VectorXd NormalFlowSolver::CollinearityWeights(const NormalFlowConstraints& constraints,
+                                                      int* pruned) const {
+  const int count = constraints.size();
+  Eigen::VectorXd weights = Eigen::VectorXd::Ones(count);
+  *pruned = 0;
+  if (!options_.collinearity_pruning) return weights;
+  // Constraints per sample (counting sort: any row order is accepted).
+  const int samples = static_cast<int>(limit_.rows());
+  std::vector<int> first(samples + 1, 0), rows(count);
+  for (int c = 0; c < count; ++c) ++first[constraints.sample[c] + 1];
+  for (int s = 0; s < samples; ++s) first[s + 1] += first[s];
+  std::vector<int> fill(first.begin(), first.end() - 1);
+  for (int c = 0; c < count; ++c) rows[fill[constraints.sample[c]]++] = c;
+
+  Eigen::VectorXd residual = Eigen::VectorXd::Zero(count);
+  std::vector<char> tested(count, 0);
+  tbb::parallel_for(0, samples, [&](int s) {
+    const int k = first[s + 1] - first[s];
+    if (k < options_.collinearity_min_cameras) return;
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (int i = first[s]; i < first[s + 1]; ++i) {
+      const Eigen::Vector3d g = constraints.gradient.row(rows[i]).transpose();
+      normal += g * g.transpose();
+      rhs += constraints.rhs(rows[i]) * g;
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal);
+    const double largest = eigen.eigenvalues()(2);
+    if (!(largest > 0.0)) return;
+    // Rank-2 solution: the two largest eigen-directions (ascending order: columns 1, 2).
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    for (int j = 1; j < 3; ++j) {
+      const double lambda = eigen.eigenvalues()(j);
+      if (lambda <= 1e-9 * largest) continue;
+      const Eigen::Vector3d u = eigen.eigenvectors().col(j);
+      velocity += (u.dot(rhs) / lambda) * u;
+    }
+    for (int i = first[s]; i < first[s + 1]; ++i) {
+      const int c = rows[i];
+      residual(c) = constraints.gradient.row(c).dot(velocity.transpose()) - constraints.rhs(c);
+      tested[c] = 1;
+    }
+  });
+  std::vector<double> tested_residuals;
+  for (int c = 0; c < count; ++c)
+    if (tested[c]) tested_residuals.push_back(residual(c));
+  const double sigma = 1.4826 * MedianAbs(tested_residuals);
+  if (!(sigma > 0.0)) return weights;
+  for (int c = 0; c < count; ++c) {
+    if (!tested[c]) continue;
+    weights(c) = Tukey(residual(c) / (options_.robust_threshold * sigma));
+    if (weights(c) == 0.0) ++*pruned;
+  }
+  return weights;
+}
+
+void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
+                                   const Eigen::VectorXd& weights,
+                                   NormalFlowSolution* solution) const {
+  const int samples = static_cast<int>(limit_.rows());
+  const int vertices = static_cast<int>(limit_.cols());
+  // Per-sample aggregates: M_s = Σ w g gᵀ (6 unique entries), h_s = Σ w b g.
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> M =
+      Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>::Zero(samples, 6);
+  Positions h = Positions::Zero(samples, 3);
+  for (int c = 0; c < constraints.size(); ++c) {
+    const double w = weights(c);
+    if (w == 0.0) continue;
+    const Eigen::RowVector3d g = constraints.gradient.row(c);
+    const int s = constraints.sample[c];
+    M.row(s) += w * Eigen::Matrix<double, 1, 6>(g(0) * g(0), g(0) * g(1), g(0) * g(2),
+                                                g(1) * g(1), g(1) * g(2), g(2) * g(2));
+    h.row(s) += (w * constraints.rhs(c)) * g;
+  }
+  // N = Σ_s L_sᵀ L_s ⊗ M_s on the finest level, interleaved (unknown 3v + axis).
+  const int* outer = pattern_.outerIndexPtr();
+  const int* inner = pattern_.innerIndexPtr();
+  Sparse N(3 * vertices, 3 * vertices);
+  N.resizeNonZeros(9 * pattern_.nonZeros());
+  for (int j = 0; j < vertices; ++j) {
+    const int m = outer[j + 1] - outer[j];
+    for (int b = 0; b < 3; ++b) {
+      const int start = 9 * outer[j] + 3 * m * b;
+      N.outerIndexPtr()[3 * j + b] = start;
+      for (int t = 0; t < m; ++t)
+        for (int a = 0; a < 3; ++a) N.innerIndexPtr()[start + 3 * t + a] = 3 * inner[outer[j] + t] + a;
+    }
+  }
+  N.outerIndexPtr()[3 * vertices] = 9 * static_cast<int>(pattern_.nonZeros());
+  double* values = N.valuePtr();
+  std::fill(values, values + 9 * pattern_.nonZeros(), 0.0);
+  for (int s = 0; s < samples; ++s) {
+    const Eigen::Matrix<double, 1, 6> m6 = M.row(s);
+    if (m6(0) == 0.0 && m6(3) == 0.0 && m6(5) == 0.0) continue;
+    Eigen::Matrix3d Ms;
+    Ms << m6(0), m6(1), m6(2), m6(1), m6(3), m6(4), m6(2), m6(4), m6(5);
+    const int begin = limit_.outerIndexPtr()[s], k = limit_.outerIndexPtr()[s + 1] - begin;
+    const int* columns = limit_.innerIndexPtr() + begin;
+    const double* l = limit_.valuePtr() + begin;
+    const int* pairs = pair_entry_.data() + sample_pair_offset_[s];
+    for (int q = 0; q < k; ++q) {
+      const int j = columns[q];
+      const int m = outer[j + 1] - outer[j];
+      for (int p = 0; p < k; ++p) {
+        const double w = l[p] * l[q];
+        const int t = pairs[p * k + q] - outer[j];
+        double* block = values + 9 * outer[j] + 3 * t;
+        for (int b = 0; b < 3; ++b)
+          for (int a = 0; a < 3; ++a) block[3 * m * b + a] += w * Ms(a, b);
+      }
+    }
+  }
+  const Positions q_positions = limit_.transpose() * h;
+  const ConstVectorMap q(q_positions.data(), 3 * vertices);
+
+  solution->displacement = Positions::Zero(vertices, 3);
+  VectorMap D(solution->displacement.data(), 3 * vertices);
+  solution->level_motion.resize(n_ + 1);
+  solution->levels.clear();
+  Positions coarse_motion = Positions::Zero(hierarchy_->VertexCount(lo_), 3);  // W_i
+  for (int level = lo_; level <= hi_; ++level) {
+    const int unknowns = 3 * hierarchy_->VertexCount(level);
+    const Sparse& P3 = prolongation3_[level];
+    Sparse A = level == n_ ? N : Sparse(P3.transpose() * Sparse(N * P3));
+    LevelSolveReport report;
+    report.level = level;
+    report.unknowns = unknowns;
+    report.data_stiffness = A.diagonal().sum() / unknowns;
+    Positions& delta = solution->level_motion[level];
+    if (delta.rows() != hierarchy_->VertexCount(level))
+      delta = Positions::Zero(hierarchy_->VertexCount(level), 3);
+    VectorMap x(delta.data(), unknowns);
+    if (report.data_stiffness > 0.0) {
+      report.smoothness_weight =
+          options_.smoothness * report.data_stiffness * length_ratio4_[level];
+      const double damping = (level == lo_ ? 1e-9 : options_.detail_damping) * report.data_stiffness;
+      const ConstVectorMap W(coarse_motion.data(), unknowns);
+      const Eigen::VectorXd rhs =
+          P3.transpose() * (q - N * D) - report.smoothness_weight * (smoothness3_[level] * W);
+      A += report.smoothness_weight * smoothness3_[level];
+      Sparse identity(unknowns, unknowns);
+      identity.setIdentity();
+      A += damping * identity;
+      Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper,
+                               Eigen::DiagonalPreconditioner<double>>
+          cg;
+      cg.setTolerance(options_.cg_tolerance);
+      cg.setMaxIterations(options_.cg_max_iterations);
+      cg.compute(A);
+      const Eigen::VectorXd guess = x;
+      x = cg.solveWithGuess(rhs, guess);
+      report.cg_iterations = static_cast<int>(cg.iterations());
+      report.cg_error = cg.error();
+    } else {
+      x.setZero();
+    }
+    D += P3 * x;
+    solution->cg_iterations += report.cg_iterations;
+    solution->levels.push_back(report);
+    if (level < hi_)
+      coarse_motion = hierarchy_->Refinement(level) * Positions(coarse_motion + delta);
+  }
+}
+
+NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constraints,
+                                           const NormalFlowSolution* warm_start) const {
+  const int samples = static_cast<int>(limit_.rows());
+  for (int c = 0; c < constraints.size(); ++c)
+    if (constraints.sample[c] < 0 || constraints.sample[c] >= samples)
+      ThrowError("normal flow solver", "constraint " + std::to_string(c),
+                 "sample index " + std::to_string(constraints.sample[c]) + " out of range");
+  NormalFlowSolution solution;
+  if (warm_start) solution.level_motion = warm_start->level_motion;
+  solution.collinearity_weights = CollinearityWeights(constraints, &solution.collinearity_pruned);
+  Eigen::VectorXd weights = solution.collinearity_weights;
+  Eigen::VectorXd residual;
+  for (int pass = 0; pass <= options_.reweighting_iterations; ++pass) {
+    SolveLevels(constraints, weights, &solution);
+    residual = constraints.Residuals(SampleMotion(solution.displacement));
+    if (pass == options_.reweighting_iterations) break;
+    std::vector<double> active;
+    for (int c = 0; c < constraints.size(); ++c)
+      if (solution.collinearity_weights(c) > 0.0) active.push_back(residual(c));
+    const double sigma = 1.4826 * MedianAbs(active);
+    if (!(sigma > 0.0)) break;
+    solution.robust_scale = sigma;
+    for (int c = 0; c < constraints.size(); ++c)
+      weights(c) = solution.collinearity_weights(c) *
+                   Tukey(residual(c) / (options_.robust_threshold * sigma));
+  }
+  solution.weights = weights;
+  double sum_zero = 0.0, sum = 0.0;
+  int kept = 0;
+  for (int c = 0; c < constraints.size(); ++c) {
+    sum_zero += constraints.rhs(c) * constraints.rhs(c);
+    if (weights(c) > 0.0) {
+      sum += residual(c) * residual(c);
+      ++kept;
+    } else {
+      ++solution.pruned;
+    }
+  }
+  solution.rms_residual_zero = constraints.size() > 0 ? std::sqrt(sum_zero / constraints.size()) : 0.0;
+  solution.rms_residual = kept > 0 ? std::sqrt(sum / kept) : 0.0;
+  return solution;
+}
+
+std::vector<Positions> LocalDetailMotion(const geometry::LoopHierarchy& hierarchy,
+                                         const Positions& finest_control,
+                                         const NormalFlowSolution& solution, int coarsest_level) {
+  const int n = hierarchy.finest_level();
+  SUBFLOW_CHECK(finest_control.rows() == hierarchy.VertexCount(n), "finest control points expected");
+  std::vector<Positions> local(n + 1);
+  Positions fine = finest_control;
+  for (int level = n; level >= 1; --level) {
+    Positions coarse = hierarchy.Coarsening(level) * fine;
+    if (level > coarsest_level && level < static_cast<int>(solution.level_motion.size()) &&
+        solution.level_motion[level].rows() == hierarchy.VertexCount(level)) {
+      const Positions predicted = hierarchy.Refinement(level - 1) * coarse;
+      local[level] =
+          geometry::ComputeLocalFrames(hierarchy, level, predicted).ToLocal(solution.level_motion[level]);
+    }
+    fine = std::move(coarse);
+  }
+  return local;
+}
+
+}  // namespace subflow::solver

@@ -1,0 +1,148 @@
+// The sparse least-squares solution of the stacked normal-flow constraints (method §4.2,
+// eq. 20–24), coarse to fine: base control motion first, then detail motion level by level.
+//
+// Unknowns. The motion (displacement over the step) of the finest control points is
+// parameterized as in the synthesis of eq. 22 with the local frames held fixed over the step
+// (the linearization the method uses, D^i = F^i):
+//   ∂c_n = Σ_{i=lo..hi} P_i δ_i,   P_i = C(n−1) ⋯ C(i)  (#V(n)×#V(i), P_n = I),
+//   δ_lo = ∂c_lo (the base control motion, lo = coarsest_level, normally 0),
+//   δ_i  = F(i) ∂d(i) for i > lo (detail motion; world vectors, so ∂d(i) = F(i)ᵀ δ_i in the
+//          frames of the current shape — LocalDetailMotion below).
+// A sample s = L c_n moves by L ∂c_n (eq. 13), so each constraint of
+// normal_flow_constraints.h, g_cᵀ (L ∂c_n)_s = b_c, is linear in every δ_i.
+//
+// Energy for level i, solved in the order lo, lo+1, …, hi with the coarser levels fixed:
+//   E_i(δ_i) = Σ_c w_c (g_cᵀ (L D_i)_s − b_c)²          D_i = Σ_{j<i} P_j δ_j + P_i δ_i
+//            + λ_i ‖U_i (W_i + δ_i)‖²                   smoothness (the aperture problem)
+//            + μ_i ‖δ_i‖²                               damping of unconstrained details
+//   U_i the umbrella Laplacian of level i (eq. 16), W_i = Σ_{j<i} C(i−1)⋯C(j) δ_j the
+//   motion of level i's control points implied by the coarser levels, so the smoothness
+//   term acts on level i's whole motion field, not only on the increment.
+//   Scaling (independent of the mesh resolution and of the world units):
+//     κ_i = mean diagonal of the data term's normal matrix on level i (per unknown),
+//     λ_i = smoothness · κ_i · (R/h_i)⁴,  R = RMS distance of the control points from their
+//     centroid, h_i = mean edge length of level i (h_n measured, h_i = 2^{n−i} h_n);
+//     the umbrella operator of a smooth field scales like h²·Δ, so this is
+//     smoothness · R⁴ ∫ |Δv|² per unit of data, a fixed continuous energy;
+//     μ_i = detail_damping · κ_i for i > lo, 1e−9 κ_lo on the base (definiteness only).
+// Each level's normal equations are solved by conjugate gradients with a diagonal (Jacobi)
+// preconditioner (Eigen::ConjugateGradient), warm-started from the previous pass.
+//
+// Robustness (pruning bad correspondences, then re-weighting):
+//   * Collinearity. The constraint planes {V : g_kᵀ V = b_k} of one sample seen by K
+//     cameras all contain the same 3D normal-flow line when the correspondences are right:
+//     every g_k lies in span{∇_S ρ, n} (the surface texture gradient and the normal), so
+//     the stacked K×3 system has rank 2 and is consistent. Per sample with K ≥
+//     collinearity_min_cameras, the rank-2 least-squares solution (the two largest
+//     eigen-directions of Σ g gᵀ) leaves a residual per constraint that measures how far
+//     the planes' pairwise intersection lines are from being collinear; constraints whose
+//     residual exceeds robust_threshold robust standard deviations (1.4826 · median
+//     absolute residual over all such constraints) are down-weighted by Tukey's biweight
+//     (zero beyond the threshold: pruned).
+//   * IRLS. After each solve, the residuals r_c = g_cᵀ (L D)_s − b_c of the whole field get
+//     Tukey weights with the same rule; the system is re-solved reweighting_iterations
+//     times. Final weight = collinearity weight × IRLS weight.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Sparse>
+
+#include "geometry/limit_evaluation.h"
+#include "geometry/loop_hierarchy.h"
+#include "geometry/triangle_mesh.h"
+#include "solver/normal_flow_constraints.h"
+
+namespace subflow::solver {
+
+struct NormalFlowSolverOptions {
+  double smoothness = 0.1;        // α: smoothness weight (dimensionless, see above)
+  double detail_damping = 1e-2;   // β: ridge on detail motions, relative to the data
+  int coarsest_level = 0;         // level solved first (the base control points)
+  int finest_level = -1;          // finest level whose details are solved; −1 = the finest
+  int reweighting_iterations = 3; // IRLS re-solves after the first (0 = plain least squares)
+  double robust_threshold = 4.685;  // Tukey constant in robust standard deviations
+  bool collinearity_pruning = true;
+  int collinearity_min_cameras = 3;  // per-sample test needs K ≥ this (≥ 3: 2 planes always meet)
+  double cg_tolerance = 1e-6;     // relative residual of each level's normal equations
+  int cg_max_iterations = 500;
+
+  void Check() const;  // throws subflow::Error naming the field
+};
+
+struct LevelSolveReport {
+  int level = 0;
+  int unknowns = 0;
+  int cg_iterations = 0;
+  double cg_error = 0.0;           // relative residual reached
+  double smoothness_weight = 0.0;  // λ_i
+  double data_stiffness = 0.0;     // κ_i
+};
+
+struct NormalFlowSolution {
+  geometry::Positions displacement;           // ∂c_n: #V(n)×3, finest control points
+  std::vector<geometry::Positions> level_motion;  // δ_i (world), indexed by level; empty
+                                                  // for levels that are not estimated
+  Eigen::VectorXd weights;               // per constraint, final weight in [0, 1]
+  Eigen::VectorXd collinearity_weights;  // per constraint (1 when not tested)
+  double robust_scale = 0.0;             // σ of the last IRLS weighting (intensity)
+  int pruned = 0;                        // constraints with final weight 0
+  int collinearity_pruned = 0;           // of which zeroed by the collinearity test
+  double rms_residual_zero = 0.0;        // √(mean b²): residual of zero motion, all rows
+  double rms_residual = 0.0;             // √(mean r²) at the solution over unpruned rows
+  std::vector<LevelSolveReport> levels;  // of the final pass
+  int cg_iterations = 0;                 // total over all passes and levels
+};
+
+class NormalFlowSolver {
+ public:
+  // `sample_limit` is L (#S × #V(n), SurfaceSamples::limit of the finest level);
+  // `reference_control` (#V(n)×3) fixes the length scales R and h_n. Precomputes the
+  // prolongations, Laplacians and the sparsity pattern of Lᵀ L. Throws subflow::Error on
+  // invalid options or sizes.
+  NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
+                   const geometry::SparseMatrix& sample_limit,
+                   const geometry::Positions& reference_control,
+                   const NormalFlowSolverOptions& options);
+
+  // Solves for the finest control displacement. `warm_start` (optional) seeds the CG
+  // iterations with a previous solution's level motions.
+  NormalFlowSolution Solve(const NormalFlowConstraints& constraints,
+                           const NormalFlowSolution* warm_start = nullptr) const;
+
+  // L ∂c_n: the samples' motion (#S×3) for a finest control displacement.
+  geometry::Positions SampleMotion(const geometry::Positions& displacement) const;
+
+  int coarsest_level() const { return lo_; }
+  int finest_estimated_level() const { return hi_; }
+  const NormalFlowSolverOptions& options() const { return options_; }
+
+ private:
+  using Sparse = Eigen::SparseMatrix<double>;  // column-major, for CG and products
+
+  Eigen::VectorXd CollinearityWeights(const NormalFlowConstraints& constraints,
+                                      int* pruned) const;
+  void SolveLevels(const NormalFlowConstraints& constraints, const Eigen::VectorXd& weights,
+                   NormalFlowSolution* solution) const;
+
+  const geometry::LoopHierarchy* hierarchy_;
+  NormalFlowSolverOptions options_;
+  int n_ = 0, lo_ = 0, hi_ = 0;
+  geometry::SparseMatrix limit_;       // L, row-major
+  Sparse pattern_;                     // pattern of Lᵀ L (#V(n) square), values unused
+  std::vector<int> pair_entry_;        // per sample, per (p, q) stencil pair: entry of pattern_
+  std::vector<int> sample_pair_offset_;  // #S + 1 offsets into pair_entry_
+  std::vector<Sparse> prolongation3_;  // P_i ⊗ I3 (3#V(n) × 3#V(i)), by level
+  std::vector<Sparse> smoothness3_;    // U_iᵀ U_i ⊗ I3, by level
+  std::vector<double> length_ratio4_;  // (R/h_i)⁴ by level
+};
+
+// The detail motions in the local frames of `finest_control`'s multires analysis:
+// ∂d(i) = F(i)ᵀ δ_i for the estimated levels i > coarsest (empty matrices elsewhere).
+std::vector<geometry::Positions> LocalDetailMotion(const geometry::LoopHierarchy& hierarchy,
+                                                   const geometry::Positions& finest_control,
+                                                   const NormalFlowSolution& solution,
+                                                   int coarsest_level);
+
+}  // namespace subflow::solver

@@ -1,0 +1,213 @@
+// Claims of vision/silhouettes.h: masks are taken as given; the background difference with
+// Otsu's threshold recovers a drawn object; motion evidence (eq. 23) is positive where
+// texture moves and zero where nothing changes; a dataset without masks, background or
+// motion is an error that says so.
+#include "vision/silhouettes.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "geometry/error.h"
+#include "vision/dataset.h"
+#include "vision/dataset_writer.h"
+#include "vision/voxel_carving.h"
+
+namespace subflow::vision {
+namespace {
+
+// A smooth random texture in [0.2, 0.8] (features of a few pixels), CV_32F.
+cv::Mat Texture(int width, int height, unsigned seed, double feature_sigma = 1.5) {
+  cv::Mat noise(height, width, CV_32F);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+  cv::GaussianBlur(noise, noise, cv::Size(), feature_sigma);
+  cv::normalize(noise, noise, 0.2, 0.8, cv::NORM_MINMAX);
+  return noise;
+}
+
+cv::Mat AddNoise(const cv::Mat& image, double sigma, unsigned seed) {
+  cv::Mat noise(image.size(), image.type());
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+  return image + noise;
+}
+
+TEST(Silhouettes, MaskIsTakenAsGiven) {
+  cv::Mat mask = cv::Mat::zeros(60, 80, CV_8UC1);
+  cv::circle(mask, cv::Point(40, 30), 15, cv::Scalar(7), cv::FILLED);  // any non-zero = object
+  const Silhouette silhouette = SilhouetteFromMask(mask);
+  EXPECT_EQ(silhouette.source, EvidenceSource::kMask);
+  EXPECT_EQ(silhouette.object_pixels, cv::countNonZero(mask));
+  EXPECT_FALSE(silhouette.empty);
+  // Exact: evidence is 1 on the mask and 0 elsewhere.
+  EXPECT_EQ(cv::countNonZero(silhouette.mask != (mask != 0)), 0);
+  EXPECT_EQ(cv::sum(silhouette.evidence)[0], silhouette.object_pixels);
+  EXPECT_EQ(cv::countNonZero(silhouette.evidence), silhouette.object_pixels);
+  EXPECT_TRUE(SilhouetteFromMask(cv::Mat::zeros(60, 80, CV_8UC1)).empty);
+  EXPECT_THROW(SilhouetteFromMask(cv::Mat::zeros(60, 80, CV_32F)), Error);
+}
+
+TEST(Silhouettes, OtsuSeparatesTwoLevels) {
+  cv::Mat image(40, 40, CV_32F, cv::Scalar(0.1));
+  image(cv::Rect(0, 0, 40, 10)).setTo(0.7);
+  const double t = OtsuThreshold(AddNoise(image, 0.02, 3));
+  // Any threshold strictly between the two levels (± 3σ of the noise) separates them.
+  EXPECT_GT(t, 0.1 + 0.06);
+  EXPECT_LT(t, 0.7 - 0.06);
+  EXPECT_FLOAT_EQ(OtsuThreshold(cv::Mat(5, 5, CV_32F, cv::Scalar(0.3))), 0.3f);  // constant image
+}
+
+// A bright disk in front of a textured background, in colour, with sensor noise.
+TEST(Silhouettes, BackgroundDifferenceWithOtsuRecoversDrawnDisk) {
+  const int width = 160, height = 120;
+  std::vector<cv::Mat> channels = {Texture(width, height, 1), Texture(width, height, 2),
+                                   Texture(width, height, 3)};
+  cv::Mat background;
+  cv::merge(channels, background);
+  cv::Mat image = background.clone();
+  cv::Mat truth = cv::Mat::zeros(height, width, CV_8UC1);
+  cv::circle(truth, cv::Point(80, 60), 35, cv::Scalar(255), cv::FILLED);
+  image.setTo(cv::Scalar(0.95, 0.9, 0.1), truth);
+  // An interior patch the colour of the background behind it: a hole that must be filled.
+  const cv::Rect patch(75, 55, 10, 10);
+  background(patch).copyTo(image(patch));
+  cv::Mat image8, background8;
+  AddNoise(image, 0.01, 4).convertTo(image8, CV_8UC3, 255.0);
+  AddNoise(background, 0.01, 5).convertTo(background8, CV_8UC3, 255.0);
+
+  const Silhouette silhouette = SilhouetteFromBackground(image8, background8);
+  EXPECT_EQ(silhouette.source, EvidenceSource::kBackground);
+  // The automatic threshold lies between the noise (d of two images with σ = 0.01 noise:
+  // ≈ 0.014, 3σ ≈ 0.04) and the disk's mean difference (d from 0.12 to 0.6 for this
+  // colour against a [0.2, 0.8] texture).
+  EXPECT_GT(silhouette.threshold, 0.04);
+  EXPECT_LT(silhouette.threshold, cv::mean(silhouette.measure, truth)[0]);
+  // The blurred edge (σ = 1 px) moves the boundary by under a pixel: the IoU loses at most
+  // perimeter × 1 px / area = 2π·35 / (π·35²) ≈ 5.7 %.
+  EXPECT_GT(SilhouetteIoU(silhouette.mask, truth), 0.943);
+  EXPECT_EQ(silhouette.mask.at<uint8_t>(60, 80), 255);  // the hole is filled
+
+  // The same scene in gray gives the same silhouette to the same tolerance.
+  cv::Mat gray_image, gray_background;
+  cv::cvtColor(image8, gray_image, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(background8, gray_background, cv::COLOR_BGR2GRAY);
+  EXPECT_GT(SilhouetteIoU(SilhouetteFromBackground(gray_image, gray_background).mask, truth), 0.943);
+
+  // No object: the difference is noise below background_min_threshold → empty.
+  EXPECT_TRUE(SilhouetteFromBackground(background8, background8).empty);
+  EXPECT_THROW(BackgroundDifference(image8, gray_background), Error);
+}
+
+// The right half's texture moves one pixel per frame to the right; the left half is static.
+TEST(Silhouettes, MotionEvidenceIsPositiveWhereTextureMovesAndZeroElsewhere) {
+  const int width = 120, height = 80, half = width / 2;
+  const cv::Mat still = Texture(width, height, 7);
+  const cv::Mat moving = Texture(width + 8, height, 8);
+  std::vector<cv::Mat> frames;
+  for (int g = 0; g < 3; ++g) {
+    cv::Mat frame = still.clone();
+    moving(cv::Rect(4 - g, 0, half, height)).copyTo(frame(cv::Rect(half, 0, half, height)));
+    frames.push_back(frame);
+  }
+  SilhouetteOptions options;
+  const cv::Mat theta = MotionEvidence(frames, 1, options);
+  // Left of the boundary by more than the smoothing support (3σ + 1 px): exactly nothing
+  // changes, so θ = 0 (to float rounding).
+  double left_max = 0;
+  cv::minMaxLoc(theta(cv::Rect(0, 0, half - 5, height)), nullptr, &left_max);
+  EXPECT_LT(left_max, 1e-6);
+  const Silhouette silhouette = SilhouetteFromMotion(frames, 1, options);
+  EXPECT_EQ(silhouette.source, EvidenceSource::kMotion);
+  const cv::Mat right = silhouette.mask(cv::Rect(half, 0, half, height));
+  const cv::Mat left = silhouette.mask(cv::Rect(0, 0, half, height));
+  // Moving texture of features ~3 px has gradients almost everywhere; after the closing
+  // the moving half is ≥ 95 % object, and the static half (but for the closing's reach of
+  // 3 px at the boundary: 3 / 60 = 5 %) is background.
+  EXPECT_GT(cv::countNonZero(right), 0.95 * right.total());
+  EXPECT_LT(cv::countNonZero(left), 0.05 * left.total());
+
+  // No motion at all: θ ≡ 0, the silhouette is empty.
+  const std::vector<cv::Mat> static_frames = {still, still, still};
+  double static_max = 0;
+  cv::minMaxLoc(MotionEvidence(static_frames, 0, options), nullptr, &static_max);
+  EXPECT_EQ(static_max, 0.0);
+  EXPECT_TRUE(SilhouetteFromMotion(static_frames, 0, options).empty);
+  EXPECT_THROW(MotionEvidence({still}, 0, options), Error);  // one frame has no ∂I/∂t
+}
+
+TEST(Silhouettes, OptionsAreChecked) {
+  SilhouetteOptions options;
+  EXPECT_NO_THROW(options.Check());
+  options.motion_lambda = 0;
+  try {
+    options.Check();
+    FAIL() << "motion_lambda = 0 accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("motion_lambda"), std::string::npos);
+  }
+  EXPECT_EQ(ParseEvidenceSource("background"), EvidenceSource::kBackground);
+  EXPECT_THROW(ParseEvidenceSource("silhouette"), Error);
+}
+
+// A tiny dataset on disk: 3 cameras, 3 frames, no masks, no background.
+class StaticDataset : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    directory_ = (std::filesystem::temp_directory_path() /
+                  ("subflow_silhouettes_test_" + std::to_string(::getpid())))
+                     .string();
+    std::vector<Camera> cameras;
+    for (int c = 0; c < 3; ++c) {
+      const double angle = 2.0 * M_PI * c / 3.0;
+      const Eigen::Vector3d centre(0.6 * std::cos(angle), 0.6 * std::sin(angle), 0.0);
+      const Eigen::Vector3d z = -centre.normalized(), y(0, 0, -1);
+      Eigen::Matrix3d R;
+      R.row(0) = y.cross(z);
+      R.row(1) = y;
+      R.row(2) = z;
+      Eigen::Matrix3d K;
+      K << 100, 0, 39.5, 0, 100, 29.5, 0, 0, 1;
+      cameras.emplace_back("cam" + std::to_string(c), 80, 60, K, R, -R * centre);
+    }
+    DatasetInfo info;
+    info.frame_count = 3;
+    info.bounds = Bounds{Eigen::Vector3d::Constant(-0.1), Eigen::Vector3d::Constant(0.1)};
+    DatasetWriter writer(directory_, cameras, info, /*overwrite=*/true);
+    for (int c = 0; c < 3; ++c) {
+      cv::Mat image;
+      Texture(80, 60, 20 + c).convertTo(image, CV_8U, 255.0);
+      for (int f = 0; f < 3; ++f) writer.WriteImage(c, f, image);  // nothing moves
+    }
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+  std::string directory_;
+};
+
+TEST_F(StaticDataset, NoMasksNoBackgroundNoMotionIsAnErrorThatSaysSo) {
+  const Dataset dataset(directory_);
+  try {
+    ComputeSilhouettes(dataset, 1);
+    FAIL() << "a static dataset without masks or background gave silhouettes";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("no masks, no background, and no motion: cannot find the object"),
+              std::string::npos)
+        << error.what();
+  }
+  SilhouetteOptions forced;
+  forced.source = EvidenceSource::kMask;
+  EXPECT_THROW(ComputeSilhouettes(dataset, 1, forced), Error);  // no masks to force
+  forced.source = EvidenceSource::kBackground;
+  EXPECT_THROW(ComputeSilhouettes(dataset, 1, forced), Error);  // no background either
+  EXPECT_THROW(ComputeSilhouettes(dataset, 3), Error);          // frame out of range
+}
+
+}  // namespace
+}  // namespace subflow::vision

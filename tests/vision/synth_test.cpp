@@ -1,0 +1,231 @@
+// `subflow synth`: its datasets must satisfy the same checks as the Blender-rendered blob
+// (masks = our cameras + z-buffer on the ground truth), have fixed-connectivity ground
+// truth with the advertised motion, and never clobber a directory.
+#include "vision/synthetic_render.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "geometry/error.h"
+#include "geometry/mesh_io.h"
+#include "vision/dataset.h"
+#include "vision/mask_agreement.h"
+#include "vision/zbuffer.h"
+
+namespace subflow::vision {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path TemporaryDirectory(const std::string& name) {
+  const fs::path path = fs::temp_directory_path() / ("subflow_synth_test_" + name + "_" +
+                                                     std::to_string(::getpid()));
+  fs::remove_all(path);
+  return path;
+}
+
+SynthOptions SmallOptions(const std::string& scene, const std::string& rig) {
+  SynthOptions options;
+  options.scene.scene = scene;
+  options.scene.frame_count = 3;
+  options.scene.motion = 3.0;  // larger steps: 3 frames still span some motion
+  options.rig.rig = rig;
+  options.rig.camera_count = 4;
+  options.rig.width = 160;
+  options.rig.height = 120;
+  options.colour_cameras = {0};
+  return options;
+}
+
+// The blob check of zbuffer_test on a synth dataset: per camera IoU ≥ 0.99 and a mean
+// centroid offset < 0.15 px between the written masks (3×3 supersampled coverage > 0.5)
+// and our z-buffer at pixel centres on the written ground truth (float PLY).
+void ExpectMasksMatchZBuffer(const fs::path& directory) {
+  const Dataset dataset(directory.string());
+  ASSERT_TRUE(dataset.has_masks());
+  ASSERT_TRUE(dataset.has_groundtruth());
+  for (int c = 0; c < dataset.camera_count(); ++c) {
+    double min_iou = 1.0;
+    Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+    for (int f = 0; f < dataset.frame_count(); ++f) {
+      const geometry::TriangleMesh mesh = geometry::ReadMesh(dataset.GroundTruthMeshPath(f));
+      const ZBuffer zbuffer(dataset.camera(c), mesh.V, mesh.F);
+      const MaskAgreement agreement = CompareMasks(zbuffer.Mask(), dataset.Mask(c, f));
+      EXPECT_GT(agreement.count_b, 500) << "the object must be in view";
+      min_iou = std::min(min_iou, agreement.iou);
+      offset += agreement.centroid_offset / dataset.frame_count();
+    }
+    std::printf("%s %s: min IoU %.4f, mean centroid offset (%+.4f, %+.4f) px\n",
+                directory.filename().c_str(), dataset.camera(c).name().c_str(), min_iou, offset.x(),
+                offset.y());
+    EXPECT_GE(min_iou, 0.99) << dataset.camera(c).name();
+    EXPECT_LT(offset.norm(), 0.15) << dataset.camera(c).name();
+  }
+}
+
+TEST(Synth, BlobRingDatasetMasksMatchTheZBufferOfItsGroundTruth) {
+  const fs::path directory = TemporaryDirectory("blob");
+  const SynthSummary summary = WriteSyntheticDataset(directory.string(), SmallOptions("blob", "ring"));
+  EXPECT_EQ(summary.camera_count, 4);
+  EXPECT_EQ(summary.frame_count, 3);
+  EXPECT_EQ(summary.vertex_count, 10242);
+  EXPECT_EQ(summary.face_count, 20480);
+  ExpectMasksMatchZBuffer(directory);
+
+  // Layout: colour camera 0 (BGR), gray others; backgrounds; bounds contain the object.
+  const Dataset dataset(directory.string());
+  EXPECT_EQ(dataset.Image(0, 0).channels(), 3);
+  EXPECT_EQ(dataset.Image(1, 0).channels(), 1);
+  ASSERT_TRUE(dataset.has_background());
+  ASSERT_TRUE(dataset.bounds_from_file());
+  for (int f = 0; f < dataset.frame_count(); ++f) {
+    const geometry::TriangleMesh mesh = geometry::ReadMesh(dataset.GroundTruthMeshPath(f));
+    for (Eigen::Index i = 0; i < mesh.V.rows(); i += 97)
+      EXPECT_TRUE(dataset.bounds().Contains(mesh.V.row(i).transpose()));
+  }
+  // Without noise, pixels away from the object (mask dilated by 2 px) equal the
+  // background image exactly; on the object the texture has contrast.
+  for (int c = 0; c < dataset.camera_count(); ++c) {
+    const cv::Mat image = dataset.Image(c, 1), background = dataset.Background(c), mask = dataset.Mask(c, 1);
+    cv::Mat near_object;
+    cv::dilate(mask, near_object, cv::Mat::ones(5, 5, CV_8U));
+    cv::Mat difference;
+    cv::absdiff(image, background, difference);
+    difference.setTo(0, near_object);
+    EXPECT_EQ(cv::countNonZero(difference.reshape(1)), 0) << "camera " << c;
+    cv::Scalar mean, deviation;
+    cv::meanStdDev(dataset.Gray(c, 1), mean, deviation, mask);
+    EXPECT_GT(deviation[0], 0.05) << "texture contrast on camera " << c;
+  }
+  fs::remove_all(directory);
+}
+
+TEST(Synth, RigidDomeAndHeadPartialDomeDatasetsPassTheMaskCheck) {
+  const fs::path rigid = TemporaryDirectory("rigid");
+  WriteSyntheticDataset(rigid.string(), SmallOptions("rigid", "dome"));
+  ExpectMasksMatchZBuffer(rigid);
+  fs::remove_all(rigid);
+  const fs::path head = TemporaryDirectory("head");
+  WriteSyntheticDataset(head.string(), SmallOptions("head", "partial-dome"));
+  ExpectMasksMatchZBuffer(head);
+  fs::remove_all(head);
+}
+
+TEST(Synth, RefusesANonEmptyDirectoryUnlessOverwriting) {
+  const fs::path directory = TemporaryDirectory("refuse");
+  fs::create_directories(directory);
+  std::ofstream(directory / "notes.txt") << "keep me\n";
+  SynthOptions options = SmallOptions("blob", "ring");
+  options.rig.camera_count = 2;
+  options.scene.frame_count = 1;
+  options.scene.subdivisions = 3;
+  try {
+    WriteSyntheticDataset(directory.string(), options);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("refusing to overwrite"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(directory / "cameras.json"));
+  options.overwrite = true;
+  WriteSyntheticDataset(directory.string(), options);
+  EXPECT_TRUE(fs::exists(directory / "cameras.json"));
+  EXPECT_TRUE(fs::exists(directory / "notes.txt"));  // only dataset entries are replaced
+  fs::remove_all(directory);
+}
+
+TEST(Synth, ScenesKeepConnectivityAndMoveAsAdvertised) {
+  for (const std::string& name : SyntheticSceneNames()) {
+    SyntheticSceneOptions options;
+    options.scene = name;
+    options.frame_count = 4;
+    options.subdivisions = 4;
+    const SyntheticScene scene = MakeSyntheticScene(options);
+    ASSERT_EQ(scene.frame_count(), 4);
+    for (const auto& V : scene.frames) ASSERT_EQ(V.rows(), scene.rest.rows());
+    const double mean_motion = (scene.frames[1] - scene.frames[0]).rowwise().norm().mean();
+    EXPECT_GT(mean_motion, 2e-4) << name;  // every scene moves (~1 mm per frame)
+    EXPECT_LT(mean_motion, 5e-3) << name;
+  }
+  // rigid: all pairwise distances are preserved (checked on a subset), to rounding.
+  SyntheticSceneOptions rigid;
+  rigid.scene = "rigid";
+  rigid.frame_count = 5;
+  rigid.subdivisions = 3;
+  const SyntheticScene scene = MakeSyntheticScene(rigid);
+  for (Eigen::Index i = 0; i < scene.rest.rows(); i += 7)
+    for (Eigen::Index j = i + 1; j < scene.rest.rows(); j += 11)
+      EXPECT_NEAR((scene.frames[4].row(i) - scene.frames[4].row(j)).norm(),
+                  (scene.frames[0].row(i) - scene.frames[0].row(j)).norm(), 1e-12);
+  // head: the back of the head turns rigidly (yaw about +z), the jaw moves more.
+  SyntheticSceneOptions head;
+  head.scene = "head";
+  head.frame_count = 11;
+  head.subdivisions = 4;
+  const SyntheticScene h = MakeSyntheticScene(head);
+  const Eigen::Matrix3d yaw = Eigen::AngleAxisd(12.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  double jaw_motion = 0.0;
+  for (Eigen::Index i = 0; i < h.rest.rows(); ++i) {
+    const Eigen::Vector3d rest = h.rest.row(i);
+    const Eigen::Vector3d moved = h.frames[10].row(i);
+    if (rest.y() > 0.0 || rest.z() > 0.0) EXPECT_LT((moved - yaw * rest).norm(), 1e-12) << "vertex " << i;
+    if (rest.y() < -0.05 && rest.z() < -0.04) jaw_motion = std::max(jaw_motion, (moved - yaw * rest).norm());
+  }
+  EXPECT_GT(jaw_motion, 0.01);  // the chin drops by over a centimetre in 10 frames
+}
+
+TEST(Synth, SensorNoiseHasTheRequestedDeviation) {
+  // σ = 4 grey levels: the difference with the noiseless rendering, away from clipping
+  // (dark background at level ~48), has standard deviation 4 ± 0.2 (≈ 19k samples; the
+  // rounding to integers adds 1/12 in variance: √(16 + 1/6) ≈ 4.02).
+  const Camera camera = LookAtCamera("cam", 160, 120, 210.0, Eigen::Vector3d(0.0, -0.6, 0.1), Eigen::Vector3d::Zero());
+  SyntheticRenderOptions clean_options;
+  SyntheticRenderOptions noisy_options;
+  noisy_options.noise_sigma = 4.0;
+  const cv::Mat clean = SyntheticRenderer(clean_options).RenderBackground(camera, false, 7);
+  const cv::Mat noisy = SyntheticRenderer(noisy_options).RenderBackground(camera, false, 7);
+  cv::Mat difference;
+  cv::subtract(noisy, clean, difference, cv::noArray(), CV_64F);
+  cv::Scalar mean, deviation;
+  cv::meanStdDev(difference, mean, deviation);
+  EXPECT_NEAR(deviation[0], 4.0, 0.2);
+  EXPECT_NEAR(mean[0], 0.0, 0.1);
+}
+
+std::string RunCommand(const std::string& arguments, int* status) {
+  const fs::path output = TemporaryDirectory("cli_output.txt");
+  const std::string command = std::string(SUBFLOW_BINARY) + " " + arguments + " > " + output.string() + " 2>&1";
+  *status = std::system(command.c_str());
+  std::stringstream text;
+  text << std::ifstream(output).rdbuf();
+  fs::remove(output);
+  return text.str();
+}
+
+TEST(Synth, CommandLineWritesADatasetAndRefusesToOverwrite) {
+  const fs::path directory = TemporaryDirectory("cli");
+  const std::string arguments = "synth rigid --out " + directory.string() +
+                                " --cameras 3 --frames 2 --width 64 --height 48 --subdivisions 3";
+  int status = 0;
+  std::string output = RunCommand(arguments, &status);
+  ASSERT_EQ(status, 0) << output;
+  EXPECT_TRUE(fs::exists(directory / "images" / "cam02" / "000001.png"));
+  EXPECT_TRUE(fs::exists(directory / "groundtruth" / "mesh" / "000001.ply"));
+  output = RunCommand(arguments, &status);
+  EXPECT_NE(status, 0);
+  EXPECT_NE(output.find("refusing to overwrite"), std::string::npos) << output;
+  output = RunCommand(arguments + " --overwrite", &status);
+  EXPECT_EQ(status, 0) << output;
+  output = RunCommand("synth cube --out " + directory.string(), &status);
+  EXPECT_NE(status, 0) << output;
+  fs::remove_all(directory);
+}
+
+}  // namespace
+}  // namespace subflow::vision

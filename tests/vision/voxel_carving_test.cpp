@@ -1,0 +1,394 @@
+// Claims of vision/voxel_carving.h and vision/voxel_morphology.h: from exact silhouettes
+// of a sphere the carved occupancy contains the sphere and lies within the sphere's
+// visual hull grown by about a voxel; a partial rig, distorted cameras and bad cameras are
+// handled; morphology and components do what their definitions say.
+#include "vision/voxel_carving.h"
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "geometry/error.h"
+#include "vision/voxel_morphology.h"
+
+namespace subflow::vision {
+namespace {
+
+using geometry::ScalarVolume;
+
+// A camera at `centre` looking at `target`, world +z up (x = z × up, y = z × x).
+Camera LookAt(const std::string& name, int width, int height, double focal,
+              const Eigen::Vector3d& centre, const Eigen::Vector3d& target,
+              const Eigen::VectorXd& distortion = Eigen::VectorXd()) {
+  const Eigen::Vector3d z = (target - centre).normalized();
+  const Eigen::Vector3d up = std::abs(z.z()) > 0.99 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d x = z.cross(up).normalized();
+  Eigen::Matrix3d R;
+  R.row(0) = x;
+  R.row(1) = z.cross(x);
+  R.row(2) = z;
+  Eigen::Matrix3d K;
+  K << focal, 0, 0.5 * (width - 1), 0, focal, 0.5 * (height - 1), 0, 0, 1;
+  return Camera(name, width, height, K, R, -R * centre, distortion);
+}
+
+Eigen::Vector3d Spherical(double distance, double azimuth_deg, double elevation_deg) {
+  const double a = azimuth_deg * M_PI / 180, e = elevation_deg * M_PI / 180;
+  return distance * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+}
+
+struct Sphere {
+  Eigen::Vector3d centre{0.01, -0.015, 0.02};
+  double radius = 0.08;
+};
+
+// Exact silhouette of the sphere in the RAW image: pixel centres whose ray (through the
+// distortion, Camera::BackProject) meets the sphere.
+cv::Mat SphereMask(const Camera& camera, const Sphere& sphere) {
+  cv::Mat mask = cv::Mat::zeros(camera.height(), camera.width(), CV_8UC1);
+  const Eigen::Vector3d to_centre = sphere.centre - camera.Center();
+  for (int y = 0; y < camera.height(); ++y)
+    for (int x = 0; x < camera.width(); ++x) {
+      const Eigen::Vector3d d = camera.BackProject(Eigen::Vector2d(x, y));
+      if (to_centre.dot(d) > 0 && (to_centre - to_centre.dot(d) * d).norm() <= sphere.radius)
+        mask.at<uint8_t>(y, x) = 255;
+    }
+  return mask;
+}
+
+// Distance from X to the silhouette cone of the sphere seen from camera centre C
+// (0 inside the cone): |X − C| sin(β − α), β = angle of X off the axis, α = half-angle.
+double DistanceToCone(const Eigen::Vector3d& X, const Eigen::Vector3d& C, const Sphere& sphere) {
+  const Eigen::Vector3d axis = sphere.centre - C, v = X - C;
+  const double alpha = std::asin(sphere.radius / axis.norm());
+  const double beta = std::acos(std::clamp(axis.normalized().dot(v.normalized()), -1.0, 1.0));
+  return beta <= alpha ? 0.0 : v.norm() * std::sin(std::min(beta - alpha, M_PI / 2));
+}
+
+// Six cameras at 0.6 m around the origin: a ring of four at 15° elevation, one from high
+// above, one from below; 160 × 120 pixels, f = 200 px (≈ 333 px/m at the centre).
+std::vector<Camera> SixCameras(const Eigen::VectorXd& distortion = Eigen::VectorXd()) {
+  std::vector<Camera> cameras;
+  const double directions[6][2] = {{20, 15}, {110, 15}, {200, 15}, {290, 15}, {60, 70}, {245, -50}};
+  for (int c = 0; c < 6; ++c)
+    cameras.push_back(LookAt("cam" + std::to_string(c), 160, 120, 200,
+                             Spherical(0.6, directions[c][0], directions[c][1]),
+                             Eigen::Vector3d::Zero(), distortion));
+  return cameras;
+}
+
+std::vector<Silhouette> SphereSilhouettes(const std::vector<Camera>& cameras, const Sphere& sphere) {
+  std::vector<Silhouette> silhouettes;
+  for (const Camera& camera : cameras) silhouettes.push_back(SilhouetteFromMask(SphereMask(camera, sphere)));
+  return silhouettes;
+}
+
+const Bounds kBounds{Eigen::Vector3d::Constant(-0.15), Eigen::Vector3d::Constant(0.15)};
+
+// The two claims about a carved sphere: (1) every voxel whose centre is inside the sphere
+// by more than one voxel is occupied; (2) every occupied voxel centre lies within
+// `tolerance` of every camera's silhouette cone (the exact visual hull grown).
+void ExpectHullOfSphere(const CarvingResult& result, const std::vector<Camera>& cameras,
+                        const Sphere& sphere, double tolerance) {
+  const ScalarVolume& volume = result.occupancy;
+  size_t inner = 0, inner_missing = 0, outside_hull = 0;
+  double worst_cone_distance = 0;
+  for (int k = 0; k < volume.nz; ++k)
+    for (int j = 0; j < volume.ny; ++j)
+      for (int i = 0; i < volume.nx; ++i) {
+        const Eigen::Vector3d X = volume.VoxelCenter(i, j, k);
+        const bool occupied = volume.at(i, j, k) > 0.5f;
+        if ((X - sphere.centre).norm() < sphere.radius - volume.spacing) {
+          ++inner;
+          inner_missing += !occupied;
+        }
+        if (!occupied) continue;
+        double cone_distance = 0;
+        for (const Camera& camera : cameras)
+          cone_distance = std::max(cone_distance, DistanceToCone(X, camera.Center(), sphere));
+        worst_cone_distance = std::max(worst_cone_distance, cone_distance);
+        outside_hull += cone_distance > tolerance;
+      }
+  EXPECT_GT(inner, 1000u);
+  EXPECT_EQ(inner_missing, 0u) << "voxels deep inside the sphere carved away";
+  EXPECT_EQ(outside_hull, 0u) << "occupied voxels farther than " << tolerance
+                              << " from the visual hull; worst " << worst_cone_distance;
+  std::printf("[ figures ] spacing %.4f, worst distance of an occupied centre to the hull %.4f (%.2f voxels)\n",
+              volume.spacing, worst_cone_distance, worst_cone_distance / volume.spacing);
+}
+
+// The largest distance from the sphere of a point of its exact visual hull (sampled on a
+// grid of step h): how much larger than the sphere a hull from these views must be.
+double VisualHullExcess(const std::vector<Camera>& cameras, const Sphere& sphere, double h) {
+  double excess = 0;
+  const int n = static_cast<int>(std::ceil(2 * 1.5 * sphere.radius / h));
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        const Eigen::Vector3d X = sphere.centre + h * Eigen::Vector3d(i, j, k) -
+                                  Eigen::Vector3d::Constant(1.5 * sphere.radius);
+        bool inside = true;
+        for (const Camera& camera : cameras)
+          inside = inside && DistanceToCone(X, camera.Center(), sphere) == 0;
+        if (inside) excess = std::max(excess, (X - sphere.centre).norm() - sphere.radius);
+      }
+  return excess;
+}
+
+TEST(VoxelCarving, SphereFromExactMasksContainsTheSphereAndLiesWithinItsHull) {
+  const Sphere sphere;
+  const std::vector<Camera> cameras = SixCameras();
+  const CarvingResult result = CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), kBounds, {});
+  // Automatic resolution: 2 px per voxel at 333 px/m → 6 mm voxels → 0.3 m / 6 mm = 50.
+  EXPECT_NEAR(result.resolution, 50, 1);
+  EXPECT_EQ(result.max_misses, 0);  // masks → strict visual hull
+  EXPECT_TRUE(result.warnings.empty()) << result.warnings.front();
+  EXPECT_EQ(result.components_kept, 1);
+  // Tolerance one voxel: a camera supports a voxel whose centre is outside its cone only
+  // when at least half of the ~3 × 3 pixel centres of its footprint are on the
+  // silhouette, i.e. within about one pixel (half a voxel) of the contour; the closing
+  // adds at most voxels next to occupied ones on concave digital steps.
+  ExpectHullOfSphere(result, cameras, sphere, result.occupancy.spacing);
+
+  // Volume: the hull of a sphere from six views is larger than the sphere by the
+  // excess computed here; the voxel count must lie between the sphere's and the grown hull's.
+  const double excess = VisualHullExcess(cameras, sphere, 0.002);
+  const double voxel_volume = std::pow(result.occupancy.spacing, 3);
+  const double volume = result.occupied_voxels * voxel_volume;
+  const double sphere_volume = 4.0 / 3.0 * M_PI * std::pow(sphere.radius, 3);
+  std::printf("[ figures ] hull excess of the exact visual hull %.4f m (%.2f voxels); "
+              "carved volume / sphere volume %.3f; mean silhouette IoU %.4f\n",
+              excess, excess / result.occupancy.spacing, volume / sphere_volume,
+              result.mean_silhouette_iou);
+  EXPECT_GT(volume, sphere_volume);
+  EXPECT_LT(volume, 4.0 / 3.0 * M_PI * std::pow(sphere.radius + excess + result.occupancy.spacing, 3));
+  // Reprojection: carving keeps voxels whose centres lie on the silhouette cones, so the
+  // projected cubes are the silhouette grown by about half a voxel (≈ 1 px); for a disk of
+  // radius r ≈ 30 px, IoU ≈ (r / (r + 1))² ≈ 0.94; required > (30 / 31.5)² ≈ 0.9.
+  for (const CameraCarvingReport& camera : result.cameras) {
+    EXPECT_TRUE(camera.used);
+    EXPECT_GT(camera.silhouette_iou, 0.9) << camera.name;
+  }
+}
+
+// The six cameras plus a narrow one (f = 600 px) that sees only the middle of the volume
+// and only part of the sphere: voxels it does not see must be carved by the others alone.
+TEST(VoxelCarving, PartialViewCarvesOnlyWhatItSees) {
+  const Sphere sphere;
+  std::vector<Camera> cameras = SixCameras();
+  cameras.push_back(LookAt("narrow", 160, 120, 600, Spherical(0.6, 330, 30), Eigen::Vector3d::Zero()));
+  VoxelCarvingOptions options;
+  options.resolution = 50;  // the automatic one would follow the narrow camera (2 mm voxels)
+  const CarvingResult result = CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), kBounds, options);
+  EXPECT_TRUE(result.cameras.back().used);
+  // The narrow camera's image is clipped by the frame: its silhouette touches the border.
+  EXPECT_GT(result.cameras.back().object_pixels, 0.5 * 160 * 120);
+  // Inside: the sphere's parts outside the narrow view are kept. Within the hull of the six
+  // full views (the narrow camera constrains only what it sees, it can only remove more).
+  ExpectHullOfSphere(result, SixCameras(), sphere, result.occupancy.spacing);
+}
+
+// Barrel distortion: the masks are in raw image coordinates, so carving must project with
+// the distortion (Camera::Project). Cameras aim 6 cm beside the sphere, so its image lies
+// off-centre where k1 = −0.3 moves the contour by a pixel or more.
+TEST(VoxelCarving, DistortedCamerasProjectWithDistortion) {
+  const Sphere sphere;
+  Eigen::VectorXd distortion(5);
+  distortion << -0.3, 0.05, 0.0, 0.0, 0.0;
+  std::vector<Camera> cameras;
+  const double directions[6][2] = {{20, 15}, {110, 15}, {200, 15}, {290, 15}, {60, 70}, {245, -50}};
+  for (int c = 0; c < 6; ++c)
+    cameras.push_back(LookAt("cam" + std::to_string(c), 160, 120, 200,
+                             Spherical(0.6, directions[c][0], directions[c][1]),
+                             Eigen::Vector3d(0.06, 0.0, -0.03), distortion));
+  const CarvingResult result = CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), kBounds, {});
+  ExpectHullOfSphere(result, cameras, sphere, result.occupancy.spacing);
+  EXPECT_GT(result.mean_silhouette_iou, 0.9);
+}
+
+TEST(VoxelCarving, BadCamerasAreExcludedWithAWarningAndTheRestIsCarved) {
+  const Sphere sphere;
+  std::vector<Camera> cameras = SixCameras();
+  std::vector<Silhouette> silhouettes = SphereSilhouettes(cameras, sphere);
+  VoxelCarvingOptions options;
+  options.compute_silhouette_iou = false;
+  const CarvingResult reference = CarveVoxels(cameras, silhouettes, kBounds, options, 7);
+
+  // A camera looking away from the volume, and one whose silhouette is empty.
+  cameras.push_back(LookAt("away", 160, 120, 200, Spherical(0.6, 0, 0), Spherical(2.0, 0, 0)));
+  silhouettes.push_back(SilhouetteFromMask(cv::Mat::zeros(120, 160, CV_8UC1)));
+  cameras.push_back(LookAt("blind", 160, 120, 200, Spherical(0.6, 150, 40), Eigen::Vector3d::Zero()));
+  silhouettes.push_back(SilhouetteFromMask(cv::Mat::zeros(120, 160, CV_8UC1)));
+  const CarvingResult result = CarveVoxels(cameras, silhouettes, kBounds, options, 7);
+  ASSERT_EQ(result.warnings.size(), 2u);
+  EXPECT_NE(result.warnings[0].find("\"away\" sees nothing of the working volume"), std::string::npos)
+      << result.warnings[0];
+  EXPECT_NE(result.warnings[1].find("frame 7: camera \"blind\" has an empty silhouette"), std::string::npos)
+      << result.warnings[1];
+  EXPECT_FALSE(result.cameras[6].used);
+  EXPECT_FALSE(result.cameras[7].used);
+  // Exact: the excluded cameras change nothing.
+  EXPECT_EQ(result.occupancy.values, reference.occupancy.values);
+
+  // Nothing usable: errors that say why.
+  std::vector<Silhouette> all_empty(6, SilhouetteFromMask(cv::Mat::zeros(120, 160, CV_8UC1)));
+  try {
+    CarveVoxels(SixCameras(), all_empty, kBounds, options, 3);
+    FAIL() << "all-empty silhouettes accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("every camera's silhouette is empty"), std::string::npos)
+        << error.what();
+  }
+  const std::vector<Camera> away_only = {cameras[6]};
+  EXPECT_THROW(CarveVoxels(away_only, {silhouettes[0]}, kBounds, options), Error);
+  EXPECT_THROW(CarveVoxels(SixCameras(), {silhouettes[0]}, kBounds, options), Error);  // count mismatch
+}
+
+TEST(VoxelCarving, ObjectLeavingTheBoundsIsReportedWithFrameAndSide) {
+  const Sphere sphere;
+  const std::vector<Camera> cameras = SixCameras();
+  Bounds cut = kBounds;
+  cut.max.x() = sphere.centre.x() + 0.5 * sphere.radius;  // the sphere sticks out at +x
+  VoxelCarvingOptions options;
+  options.resolution = 40;
+  const CarvingResult result = CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), cut, options, 5);
+  EXPECT_GT(result.border_voxels[1], 0u);
+  EXPECT_EQ(result.border_voxels[0] + result.border_voxels[2] + result.border_voxels[3] +
+                result.border_voxels[4] + result.border_voxels[5],
+            0u);
+  ASSERT_EQ(result.warnings.size(), 1u);
+  EXPECT_NE(result.warnings[0].find("frame 5: the object touches the +x side"), std::string::npos)
+      << result.warnings[0];
+}
+
+TEST(VoxelCarving, OptionsAreChecked) {
+  VoxelCarvingOptions options;
+  EXPECT_NO_THROW(options.Check());
+  options.connectivity = 8;
+  try {
+    options.Check();
+    FAIL() << "connectivity 8 accepted";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("connectivity"), std::string::npos);
+  }
+}
+
+TEST(VoxelGrid, CoversTheBoundsWithCubicVoxels) {
+  const Bounds bounds{Eigen::Vector3d(-1, -0.5, 0), Eigen::Vector3d(1, 0.5, 0.3)};
+  const ScalarVolume grid = MakeVoxelGrid(bounds, 20);  // 0.1 voxels
+  EXPECT_EQ(grid.nx, 20);
+  EXPECT_EQ(grid.ny, 10);
+  EXPECT_EQ(grid.nz, 3);
+  EXPECT_DOUBLE_EQ(grid.spacing, 0.1);
+  // Centred: the first and last voxel centres sit half a voxel inside the bounds.
+  EXPECT_NEAR(grid.origin.x(), -0.95, 1e-12);
+  EXPECT_NEAR(grid.VoxelCenter(19, 9, 2).x(), 0.95, 1e-12);
+  EXPECT_NEAR(grid.origin.z(), 0.05, 1e-12);
+}
+
+// ---- morphology and components ----
+
+ScalarVolume Volume(int n) { return ScalarVolume(Eigen::Vector3d::Zero(), 1.0, n, n, n, 0.0f); }
+
+void FillBox(ScalarVolume* v, int lo, int hi, float value = 1.0f) {  // [lo, hi)³
+  for (int k = lo; k < hi; ++k)
+    for (int j = lo; j < hi; ++j)
+      for (int i = lo; i < hi; ++i) v->at(i, j, k) = value;
+}
+
+TEST(VoxelMorphology, SeparableBoxPassesEqualBruteForce) {
+  ScalarVolume random(Eigen::Vector3d::Zero(), 1.0, 21, 17, 13);
+  std::mt19937 rng(11);
+  for (float& value : random.values) value = (rng() % 100) < 20 ? 1.0f : 0.0f;
+  for (int r : {1, 2}) {
+    ScalarVolume dilated = random, eroded = random;
+    DilateBox(&dilated, r);
+    ErodeBox(&eroded, r);
+    size_t dilate_errors = 0, erode_errors = 0;
+    for (int k = 0; k < random.nz; ++k)
+      for (int j = 0; j < random.ny; ++j)
+        for (int i = 0; i < random.nx; ++i) {
+          bool any = false, all = true;  // outside: empty for dilation, occupied for erosion
+          for (int dk = -r; dk <= r; ++dk)
+            for (int dj = -r; dj <= r; ++dj)
+              for (int di = -r; di <= r; ++di) {
+                if (!random.InRange(i + di, j + dj, k + dk)) continue;
+                const bool on = random.at(i + di, j + dj, k + dk) > 0.5f;
+                any = any || on;
+                all = all && on;
+              }
+          dilate_errors += (dilated.at(i, j, k) > 0.5f) != any;
+          erode_errors += (eroded.at(i, j, k) > 0.5f) != all;
+        }
+    EXPECT_EQ(dilate_errors, 0u) << "radius " << r;
+    EXPECT_EQ(erode_errors, 0u) << "radius " << r;
+  }
+}
+
+TEST(VoxelMorphology, OpeningRemovesNoiseVoxelClosingFillsOneVoxelHole) {
+  ScalarVolume cube = Volume(30);
+  FillBox(&cube, 8, 22);
+  ScalarVolume noisy = cube;
+  noisy.at(15, 15, 15) = 0.0f;  // one-voxel hole inside
+  noisy.at(15, 8, 15) = 0.0f;   // one-voxel pit in the surface
+  noisy.at(3, 3, 3) = 1.0f;     // isolated noise voxel
+  noisy.at(15, 22, 15) = 1.0f;  // one-voxel bump on the surface
+  CloseBox(&noisy, 1);
+  OpenBox(&noisy, 1);
+  EXPECT_EQ(noisy.values, cube.values);  // exact: the 14³ cube is open and closed for r = 1
+}
+
+TEST(VoxelMorphology, ClosingAndOpeningKeepAnObjectCutByTheBorder) {
+  ScalarVolume slab = Volume(12);
+  for (int k = 0; k < 12; ++k)
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i < 5; ++i) slab.at(i, j, k) = 1.0f;  // touches five faces
+  ScalarVolume closed = slab, opened = slab;
+  CloseBox(&closed, 2);
+  OpenBox(&opened, 2);
+  EXPECT_EQ(closed.values, slab.values);
+  EXPECT_EQ(opened.values, slab.values);
+}
+
+TEST(VoxelMorphology, ComponentsKeepTheBigObject) {
+  ScalarVolume volume = Volume(30);
+  FillBox(&volume, 10, 20);  // 1000 voxels
+  ScalarVolume big_only = volume;
+  FillBox(&volume, 2, 4);  // 8 voxels, far away
+  const ComponentSummary summary = KeepLargeComponents(&volume, 0.1);
+  EXPECT_EQ(summary.found, 2);
+  EXPECT_EQ(summary.kept, 1);
+  EXPECT_EQ(summary.largest, 1000u);
+  EXPECT_EQ(summary.removed_voxels, 8u);
+  EXPECT_EQ(volume.values, big_only.values);
+
+  // Two cubes touching at one corner: one component in 26-connectivity, two in 6.
+  ScalarVolume corners = Volume(10);
+  FillBox(&corners, 1, 4);
+  FillBox(&corners, 4, 7);
+  ScalarVolume copy = corners;
+  EXPECT_EQ(KeepLargeComponents(&corners, 0.0, 26).found, 1);
+  EXPECT_EQ(KeepLargeComponents(&copy, 0.0, 6).found, 2);
+}
+
+TEST(VoxelMorphology, InteriorCavitiesAreFilledOpenOnesAreNot) {
+  ScalarVolume shell = Volume(20);
+  FillBox(&shell, 4, 16);
+  FillBox(&shell, 7, 13, 0.0f);  // 6³ = 216 empty voxels enclosed
+  ScalarVolume solid = Volume(20);
+  FillBox(&solid, 4, 16);
+  EXPECT_EQ(FillCavities(&shell), 216u);
+  EXPECT_EQ(shell.values, solid.values);
+
+  ScalarVolume open = Volume(20);
+  FillBox(&open, 4, 16);
+  FillBox(&open, 7, 13, 0.0f);
+  for (int i = 0; i < 7; ++i) open.at(i, 10, 10) = 0.0f;  // a tunnel to the border
+  EXPECT_EQ(FillCavities(&open), 0u);
+}
+
+}  // namespace
+}  // namespace subflow::vision

@@ -1,0 +1,315 @@
+#include "vision/dataset_layout.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "geometry/error.h"
+
+namespace subflow::vision {
+namespace fs = std::filesystem;
+namespace {
+
+std::string Str(const fs::path& path) { return path.string(); }
+
+bool Hidden(const fs::path& path) { return path.filename().string().rfind('.', 0) == 0; }
+
+std::string SizeText(int width, int height) {
+  return std::to_string(width) + "×" + std::to_string(height);
+}
+
+std::string CameraList(const std::vector<Camera>& cameras) {
+  std::string list;
+  for (const Camera& camera : cameras) list += (list.empty() ? "" : ", ") + camera.name();
+  return list;
+}
+
+// Frame index of "<6 digits><extension>", or -1.
+int FrameIndex(const std::string& file_name, const std::string& extension) {
+  if (file_name.size() != 6 + extension.size() || file_name.compare(6, std::string::npos, extension) != 0)
+    return -1;
+  for (int i = 0; i < 6; ++i)
+    if (!std::isdigit(static_cast<unsigned char>(file_name[i]))) return -1;
+  return std::stoi(file_name.substr(0, 6));
+}
+
+// Width and height from a PNG's IHDR chunk (the first 24 bytes).
+void CheckPngHeader(const std::string& path, const Camera& camera) {
+  std::ifstream file(path, std::ios::binary);
+  unsigned char header[24] = {};
+  file.read(reinterpret_cast<char*>(header), sizeof(header));
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (!file || !std::equal(kSignature, kSignature + 8, header) ||
+      !std::equal(header + 12, header + 16, reinterpret_cast<const unsigned char*>("IHDR")))
+    ThrowError(path, "", "unreadable image: expected a PNG file (bad or truncated PNG header)");
+  auto big_endian = [&](int offset) {
+    return (int(header[offset]) << 24) | (int(header[offset + 1]) << 16) |
+           (int(header[offset + 2]) << 8) | int(header[offset + 3]);
+  };
+  const int width = big_endian(16), height = big_endian(20);
+  if (width != camera.width() || height != camera.height())
+    ThrowError(path, "size",
+               "expected " + SizeText(camera.width(), camera.height()) + " (camera \"" +
+                   camera.name() + "\" in cameras.json), got " + SizeText(width, height));
+}
+
+// The per-camera folders <root>/<camera>/ of <frame><extension> files (images/, masks/):
+// returns each camera's frame indices; throws on unknown folders, stray files and
+// cameras without a folder or without frames.
+std::vector<std::set<int>> ScanFrameFolders(const fs::path& root, const std::vector<Camera>& cameras,
+                                            const std::string& extension) {
+  std::set<std::string> names;
+  for (const Camera& camera : cameras) names.insert(camera.name());
+  for (const auto& entry : fs::directory_iterator(root)) {
+    if (Hidden(entry.path())) continue;
+    if (!entry.is_directory() || !names.count(entry.path().filename().string()))
+      ThrowError(Str(entry.path()), "",
+                 "unknown camera folder (expected one folder per camera of cameras.json: " +
+                     CameraList(cameras) + ")");
+  }
+  std::vector<std::set<int>> frames(cameras.size());
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    const fs::path folder = root / cameras[c].name();
+    if (!fs::is_directory(folder))
+      ThrowError(Str(folder), "", "missing: camera \"" + cameras[c].name() +
+                                      "\" has no folder (expected " + Str(folder) + "/000000" +
+                                      extension + ", ...)");
+    for (const auto& entry : fs::directory_iterator(folder)) {
+      if (Hidden(entry.path())) continue;
+      const int frame = FrameIndex(entry.path().filename().string(), extension);
+      if (frame < 0 || !entry.is_regular_file())
+        ThrowError(Str(entry.path()), "",
+                   "unexpected file (expected frames named <6-digit frame>" + extension + ", e.g. 000000" +
+                       extension + ")");
+      frames[c].insert(frame);
+    }
+    if (frames[c].empty())
+      ThrowError(Str(folder), "", "camera \"" + cameras[c].name() + "\" has no images (expected " +
+                                      Str(folder / ("000000" + extension)) + ", ...)");
+  }
+  return frames;
+}
+
+// Every camera has exactly frames 0..frame_count-1.
+void CheckFrames(const std::vector<std::set<int>>& frames, int frame_count, const fs::path& root,
+                 const std::vector<Camera>& cameras, const std::string& extension,
+                 const std::string& count_origin) {
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    for (int f = 0; f < frame_count; ++f)
+      if (!frames[c].count(f))
+        ThrowError(Str(root / cameras[c].name() / (FrameName(f) + extension)), "",
+                   "missing frame " + std::to_string(f) + " of camera \"" + cameras[c].name() +
+                       "\" (every camera must have frames 0.." + std::to_string(frame_count - 1) +
+                       ", " + count_origin + ")");
+    const int last = *frames[c].rbegin();
+    if (last >= frame_count)
+      ThrowError(Str(root / cameras[c].name() / (FrameName(last) + extension)), "",
+                 "frame beyond frame_count " + std::to_string(frame_count) + " (" + count_origin + ")");
+  }
+}
+
+}  // namespace
+
+std::string DatasetLayout::ImagePath(int camera, int frame) const {
+  if (videos) return video_paths[camera];
+  return Str(fs::path(directory) / "images" / cameras[camera].name() / (FrameName(frame) + ".png"));
+}
+std::string DatasetLayout::MaskPath(int camera, int frame) const {
+  return Str(fs::path(directory) / "masks" / cameras[camera].name() / (FrameName(frame) + ".png"));
+}
+std::string DatasetLayout::BackgroundPath(int camera) const {
+  return Str(fs::path(directory) / "background" / (cameras[camera].name() + ".png"));
+}
+std::string DatasetLayout::GroundTruthMeshPath(int frame) const {
+  return Str(fs::path(directory) / "groundtruth" / "mesh" / (FrameName(frame) + ".ply"));
+}
+
+void DatasetLayout::CheckIndex(int camera, int frame) const {
+  if (camera < 0 || camera >= static_cast<int>(cameras.size()))
+    ThrowError(directory, "camera index", "expected 0.." + std::to_string(cameras.size() - 1) +
+                                              ", got " + std::to_string(camera));
+  if (frame < 0 || frame >= frame_count)
+    ThrowError(directory, "frame index", "expected 0.." + std::to_string(frame_count - 1) +
+                                             ", got " + std::to_string(frame));
+}
+
+void CheckImageSize(const cv::Mat& image, const Camera& camera, const std::string& what) {
+  if (image.cols != camera.width() || image.rows != camera.height())
+    ThrowError(what, "size",
+               "expected " + SizeText(camera.width(), camera.height()) + " (camera \"" +
+                   camera.name() + "\" in cameras.json), got " + SizeText(image.cols, image.rows));
+}
+
+cv::Mat ReadImageFile(const std::string& path, const Camera& camera) {
+  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty())
+    ThrowError(path, "", fs::exists(path) ? "unreadable image (cv::imread failed; expected an 8- or "
+                                            "16-bit PNG)"
+                                          : "missing image file");
+  if ((image.depth() != CV_8U && image.depth() != CV_16U) ||
+      (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
+    ThrowError(path, "pixel type",
+               "expected 8- or 16-bit with 1, 3 or 4 channels, got depth " + std::to_string(image.depth()) +
+                   " with " + std::to_string(image.channels()) + " channels");
+  CheckImageSize(image, camera, path);
+  return image;
+}
+
+namespace {
+
+DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers) {
+  DatasetLayout layout;
+
+  layout.directory = directory;
+  const fs::path root(directory);
+  if (!fs::is_directory(root))
+    ThrowError(directory, "", "not a directory (expected a dataset directory with cameras.json)");
+  layout.cameras_path = Str(root / "cameras.json");
+  layout.cameras = ReadCamerasJson(layout.cameras_path, &layout.info);
+  const std::vector<Camera>& cameras = layout.cameras;
+  const std::string count_origin =
+      layout.info.frame_count ? "frame_count in cameras.json" : "frame count found on disk";
+
+  const fs::path images = root / "images", videos = root / "videos";
+  if (fs::exists(images) && fs::exists(videos))
+    ThrowError(directory, "images/ and videos/", "both present; expected exactly one source of frames");
+  if (fs::is_directory(images)) {
+    const std::vector<std::set<int>> frames = ScanFrameFolders(images, cameras, ".png");
+    if (layout.info.frame_count) {
+      layout.frame_count = *layout.info.frame_count;
+    } else {
+      for (const auto& set : frames) layout.frame_count = std::max(layout.frame_count, *set.rbegin() + 1);
+    }
+    CheckFrames(frames, layout.frame_count, images, cameras, ".png", count_origin);
+  } else if (fs::is_directory(videos)) {
+    layout.videos = true;
+    layout.video_paths.resize(cameras.size());
+    for (const auto& entry : fs::directory_iterator(videos)) {
+      if (Hidden(entry.path())) continue;
+      const std::string stem = entry.path().stem().string();
+      auto it = std::find_if(cameras.begin(), cameras.end(),
+                             [&](const Camera& camera) { return camera.name() == stem; });
+      if (it == cameras.end() || !entry.is_regular_file())
+        ThrowError(Str(entry.path()), "", "unknown camera video (expected videos/<camera>.<ext> for the "
+                                          "cameras of cameras.json: " + CameraList(cameras) + ")");
+      std::string& path = layout.video_paths[it - cameras.begin()];
+      if (!path.empty())
+        ThrowError(Str(entry.path()), "", "second video of camera \"" + stem + "\" (the first is " + path + ")");
+      path = Str(entry.path());
+    }
+    std::map<int, std::string> counts;  // reported frame count → a video with it
+    for (std::size_t c = 0; c < cameras.size(); ++c) {
+      const std::string& path = layout.video_paths[c];
+      if (path.empty())
+        ThrowError(Str(videos / cameras[c].name()), "", "camera \"" + cameras[c].name() +
+                                                            "\" has no video (expected videos/" +
+                                                            cameras[c].name() + ".<ext>)");
+      cv::VideoCapture capture(path);
+      if (!capture.isOpened())
+        ThrowError(path, "", "unreadable video (expected a file OpenCV's VideoCapture reads)");
+      const int width = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_WIDTH));
+      const int height = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_HEIGHT));
+      if (width != cameras[c].width() || height != cameras[c].height())
+        ThrowError(path, "size", "expected " + SizeText(cameras[c].width(), cameras[c].height()) +
+                                     " (camera \"" + cameras[c].name() + "\" in cameras.json), got " +
+                                     SizeText(width, height));
+      const int count = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_COUNT));
+      if (layout.info.frame_count) {
+        if (count > 0 && count < *layout.info.frame_count)
+          ThrowError(path, "frame count", "expected at least frame_count = " +
+                                              std::to_string(*layout.info.frame_count) +
+                                              " frames (cameras.json), the video has " + std::to_string(count));
+      } else if (count <= 0) {
+        ThrowError(path, "frame count", "unknown (the container does not report it); give "
+                                        "\"frame_count\" in cameras.json");
+      }
+      counts[count] = path;
+    }
+    if (layout.info.frame_count) {
+      layout.frame_count = *layout.info.frame_count;
+    } else {
+      if (counts.size() > 1)
+        ThrowError(counts.rbegin()->second, "frame count",
+                   "expected every video to have the same number of frames, got " +
+                       std::to_string(counts.rbegin()->first) + " here and " +
+                       std::to_string(counts.begin()->first) + " in " + counts.begin()->second);
+      layout.frame_count = counts.begin()->first;
+    }
+  } else {
+    ThrowError(directory, "images/", "missing (expected images/<camera>/<frame>.png or videos/<camera>.<ext>)");
+  }
+
+  const fs::path masks = root / "masks";
+  if (fs::exists(masks)) {
+    if (!fs::is_directory(masks)) ThrowError(Str(masks), "", "expected a folder of per-camera mask folders");
+    layout.masks = true;
+    const std::vector<std::set<int>> frames = ScanFrameFolders(masks, cameras, ".png");
+    CheckFrames(frames, layout.frame_count, masks, cameras, ".png",
+                "the frame count of the dataset's images");
+  }
+
+  const fs::path background = root / "background";
+  if (fs::exists(background)) {
+    layout.background = true;
+    std::set<std::string> names;
+    for (const Camera& camera : cameras) names.insert(camera.name() + ".png");
+    for (const auto& entry : fs::directory_iterator(background)) {
+      if (Hidden(entry.path())) continue;
+      if (!names.count(entry.path().filename().string()))
+        ThrowError(Str(entry.path()), "", "unknown background image (expected background/<camera>.png "
+                                          "for the cameras of cameras.json: " + CameraList(cameras) + ")");
+    }
+    for (int c = 0; c < static_cast<int>(cameras.size()); ++c)
+      if (!fs::is_regular_file(layout.BackgroundPath(c)))
+        ThrowError(layout.BackgroundPath(c), "", "missing background image of camera \"" + cameras[c].name() +
+                                                     "\" (background/ must have one per camera)");
+  }
+
+  const fs::path groundtruth = root / "groundtruth";
+  if (fs::exists(groundtruth)) {
+    const fs::path mesh = groundtruth / "mesh";
+    if (!fs::is_directory(mesh))
+      ThrowError(Str(mesh), "", "missing (expected groundtruth/mesh/<frame>.ply)");
+    layout.groundtruth = true;
+    for (const auto& entry : fs::directory_iterator(mesh)) {
+      if (Hidden(entry.path())) continue;
+      const int frame = FrameIndex(entry.path().filename().string(), ".ply");
+      if (frame < 0 || frame >= layout.frame_count)
+        ThrowError(Str(entry.path()), "", "unexpected file (expected <frame>.ply for frames 000000.." +
+                                              FrameName(layout.frame_count - 1) + ")");
+    }
+    for (int f = 0; f < layout.frame_count; ++f)
+      if (!fs::is_regular_file(layout.GroundTruthMeshPath(f)))
+        ThrowError(layout.GroundTruthMeshPath(f), "", "missing ground-truth mesh of frame " + std::to_string(f));
+  }
+
+  if (check_image_headers) {
+    for (int c = 0; c < static_cast<int>(cameras.size()); ++c) {
+      for (int f = 0; f < layout.frame_count; ++f) {
+        if (!layout.videos) CheckPngHeader(layout.ImagePath(c, f), cameras[c]);
+        if (layout.masks) CheckPngHeader(layout.MaskPath(c, f), cameras[c]);
+      }
+      if (layout.background) CheckPngHeader(layout.BackgroundPath(c), cameras[c]);
+    }
+  }
+  return layout;
+}
+
+}  // namespace
+
+DatasetLayout ScanDatasetLayout(const std::string& directory, bool check_image_headers) {
+  try {
+    return ScanLayout(directory, check_image_headers);
+  } catch (const fs::filesystem_error& e) {
+    // Permissions, broken links and the like: still one line naming the path.
+    ThrowError(e.path1().empty() ? directory : e.path1().string(), "", e.code().message());
+  }
+}
+
+}  // namespace subflow::vision

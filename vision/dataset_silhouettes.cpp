@@ -1,0 +1,97 @@
+// The Dataset-facing entry points of silhouettes and voxel carving (declared in
+// vision/silhouettes.h and vision/voxel_carving.h), kept apart so that code using only
+// the image-level functions does not link the dataset reader.
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include <tbb/parallel_for.h>
+
+#include "geometry/error.h"
+#include "vision/dataset.h"
+#include "vision/silhouettes.h"
+#include "vision/voxel_carving.h"
+
+namespace subflow::vision {
+
+std::vector<Silhouette> ComputeSilhouettes(const Dataset& dataset, int frame,
+                                           const SilhouetteOptions& options) {
+  options.Check();
+  const std::string& source_name = dataset.directory();
+  if (frame < 0 || frame >= dataset.frame_count())
+    ThrowError(source_name, "frame",
+               "expected a frame in [0, " + std::to_string(dataset.frame_count() - 1) + "], got " +
+                   std::to_string(frame));
+  if (options.source == EvidenceSource::kMask && !dataset.has_masks())
+    ThrowError(source_name, "masks/", "evidence source \"mask\" asked for, but the dataset has no masks");
+  if (options.source == EvidenceSource::kMotion && dataset.frame_count() < 2)
+    ThrowError(source_name, "frame_count",
+               "evidence source \"motion\" needs at least 2 frames, the dataset has 1");
+
+  const int camera_count = dataset.camera_count();
+  std::vector<EvidenceSource> sources(camera_count, options.source);
+  for (int c = 0; c < camera_count; ++c) {
+    const bool has_background = std::filesystem::exists(dataset.BackgroundPath(c));
+    if (options.source == EvidenceSource::kBackground && !has_background)
+      ThrowError(dataset.BackgroundPath(c), "background",
+                 "evidence source \"background\" asked for, but this file does not exist");
+    if (options.source == EvidenceSource::kAuto)
+      sources[c] = dataset.has_masks() ? EvidenceSource::kMask
+                   : has_background     ? EvidenceSource::kBackground
+                                        : EvidenceSource::kMotion;
+  }
+
+  std::vector<Silhouette> silhouettes(camera_count);
+  tbb::parallel_for(0, camera_count, [&](int c) {
+    switch (sources[c]) {
+      case EvidenceSource::kMask:
+        silhouettes[c] = SilhouetteFromMask(dataset.Mask(c, frame), options);
+        break;
+      case EvidenceSource::kBackground:
+        // Colour when both images have colour (distance in colour separates better), else gray.
+        {
+          cv::Mat image = dataset.Image(c, frame), background = dataset.Background(c);
+          if (image.type() != background.type()) {
+            image = dataset.Gray(c, frame);
+            background = dataset.BackgroundGray(c);
+          }
+          silhouettes[c] = SilhouetteFromBackground(image, background, options);
+        }
+        break;
+      default: {
+        if (dataset.frame_count() < 2) {
+          Silhouette none = ThresholdAndClean(
+              cv::Mat::zeros(dataset.camera(c).height(), dataset.camera(c).width(), CV_32F),
+              0.0, options);
+          none.source = EvidenceSource::kMotion;
+          silhouettes[c] = none;
+          break;
+        }
+        const int first = std::max(0, frame - options.motion_window - 1);
+        const int last = std::min(dataset.frame_count() - 1, frame + options.motion_window + 1);
+        std::vector<cv::Mat> gray;
+        for (int g = first; g <= last; ++g) gray.push_back(dataset.Gray(c, g));
+        silhouettes[c] = SilhouetteFromMotion(gray, frame - first, options);
+      }
+    }
+  });
+
+  bool all_motion = true, all_empty = true;
+  for (int c = 0; c < camera_count; ++c) {
+    all_motion = all_motion && silhouettes[c].source == EvidenceSource::kMotion;
+    all_empty = all_empty && silhouettes[c].empty;
+  }
+  if (all_motion && all_empty)
+    ThrowError(source_name, "frame " + std::to_string(frame),
+               "no masks, no background, and no motion: cannot find the object");
+  return silhouettes;
+}
+
+CarvingResult CarveFrame(const Dataset& dataset, int frame, const SilhouetteOptions& silhouette_options,
+                         const VoxelCarvingOptions& carving_options) {
+  carving_options.Check();
+  const std::vector<Silhouette> silhouettes = ComputeSilhouettes(dataset, frame, silhouette_options);
+  return CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), carving_options, frame);
+}
+
+}  // namespace subflow::vision

@@ -1,0 +1,114 @@
+#include "vision/dataset_writer.h"
+
+#include <filesystem>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "geometry/error.h"
+#include "geometry/mesh_io.h"
+
+namespace subflow::vision {
+namespace fs = std::filesystem;
+namespace {
+
+const char* const kDatasetEntries[] = {"cameras.json", "images", "videos", "masks", "background",
+                                       "groundtruth"};
+
+void CreateDirectories(const fs::path& path) {
+  std::error_code error;
+  fs::create_directories(path, error);
+  if (error) ThrowError(path.string(), "", "cannot create directory: " + error.message());
+}
+
+// PNG written beside the target then renamed, so no half-written frame is ever left.
+void WritePng(const fs::path& path, const cv::Mat& image) {
+  CreateDirectories(path.parent_path());
+  const fs::path temporary = path.string() + ".tmp.png";
+  bool written = false;
+  try {
+    written = cv::imwrite(temporary.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 3});
+  } catch (const cv::Exception& e) {
+    ThrowError(path.string(), "", std::string("cannot write PNG: ") + e.what());
+  }
+  if (!written) ThrowError(path.string(), "", "cannot write PNG (cv::imwrite failed)");
+  std::error_code error;
+  fs::rename(temporary, path, error);
+  if (error) ThrowError(path.string(), "", "cannot write (rename failed: " + error.message() + ")");
+}
+
+}  // namespace
+
+DatasetWriter::DatasetWriter(const std::string& directory, std::vector<Camera> cameras,
+                             const DatasetInfo& info, bool overwrite)
+    : directory_(directory), cameras_(std::move(cameras)), info_(info) {
+  const fs::path root(directory_);
+  if (fs::exists(root)) {
+    if (!fs::is_directory(root))
+      ThrowError(directory_, "", "exists and is not a directory (expected a new dataset directory)");
+    if (!fs::is_empty(root)) {
+      if (!overwrite)
+        ThrowError(directory_, "", "exists and is not empty; refusing to overwrite (set overwrite to "
+                                   "replace the dataset in it)");
+      for (const char* entry : kDatasetEntries) {
+        std::error_code error;
+        fs::remove_all(root / entry, error);
+        if (error) ThrowError((root / entry).string(), "", "cannot remove: " + error.message());
+      }
+    }
+  }
+  CreateDirectories(root);
+  WriteCamerasJson((root / "cameras.json").string(), cameras_, info_.fps, info_.frame_count,
+                   info_.bounds, info_.units);
+  for (const Camera& camera : cameras_) CreateDirectories(root / "images" / camera.name());
+}
+
+void DatasetWriter::CheckImage(int camera, const cv::Mat& image, const std::string& path) const {
+  if (camera < 0 || camera >= static_cast<int>(cameras_.size()))
+    ThrowError(path, "camera index", "expected 0.." + std::to_string(cameras_.size() - 1) + ", got " +
+                                         std::to_string(camera));
+  const Camera& c = cameras_[camera];
+  if (image.cols != c.width() || image.rows != c.height())
+    ThrowError(path, "size", "expected " + std::to_string(c.width()) + "×" + std::to_string(c.height()) +
+                                 " (camera \"" + c.name() + "\"), got " + std::to_string(image.cols) + "×" +
+                                 std::to_string(image.rows));
+  if ((image.depth() != CV_8U && image.depth() != CV_16U) ||
+      (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
+    ThrowError(path, "pixel type", "expected 8- or 16-bit with 1, 3 or 4 channels");
+}
+
+void DatasetWriter::WriteImage(int camera, int frame, const cv::Mat& image) const {
+  if (frame < 0 || (info_.frame_count && frame >= *info_.frame_count))
+    ThrowError(directory_, "frame index", "out of range: " + std::to_string(frame));
+  if (camera < 0 || camera >= static_cast<int>(cameras_.size())) CheckImage(camera, image, directory_);
+  const fs::path path = fs::path(directory_) / "images" / cameras_[camera].name() / (FrameName(frame) + ".png");
+  CheckImage(camera, image, path.string());
+  WritePng(path, image);
+}
+
+void DatasetWriter::WriteMask(int camera, int frame, const cv::Mat& mask) const {
+  if (frame < 0 || (info_.frame_count && frame >= *info_.frame_count))
+    ThrowError(directory_, "frame index", "out of range: " + std::to_string(frame));
+  if (camera < 0 || camera >= static_cast<int>(cameras_.size())) CheckImage(camera, mask, directory_);
+  const fs::path path = fs::path(directory_) / "masks" / cameras_[camera].name() / (FrameName(frame) + ".png");
+  CheckImage(camera, mask, path.string());
+  if (mask.type() != CV_8UC1) ThrowError(path.string(), "pixel type", "expected a CV_8UC1 mask");
+  cv::Mat binary = mask != 0;
+  WritePng(path, binary);
+}
+
+void DatasetWriter::WriteBackground(int camera, const cv::Mat& image) const {
+  if (camera < 0 || camera >= static_cast<int>(cameras_.size())) CheckImage(camera, image, directory_);
+  const fs::path path = fs::path(directory_) / "background" / (cameras_[camera].name() + ".png");
+  CheckImage(camera, image, path.string());
+  WritePng(path, image);
+}
+
+void DatasetWriter::WriteGroundTruthMesh(int frame, const geometry::TriangleMesh& mesh) const {
+  if (frame < 0 || (info_.frame_count && frame >= *info_.frame_count))
+    ThrowError(directory_, "frame index", "out of range: " + std::to_string(frame));
+  const fs::path path = fs::path(directory_) / "groundtruth" / "mesh" / (FrameName(frame) + ".ply");
+  CreateDirectories(path.parent_path());
+  geometry::WriteMesh(path.string(), mesh);
+}
+
+}  // namespace subflow::vision

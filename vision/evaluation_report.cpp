@@ -1,0 +1,151 @@
+// vision/evaluation.h on files: listing and reading the frame meshes, and the report's
+// table and JSON.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "geometry/error.h"
+#include "geometry/mesh_io.h"
+#include "vision/evaluation.h"
+
+namespace subflow::vision {
+namespace fs = std::filesystem;
+namespace {
+
+std::string FrameFileName(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06d.ply", frame);
+  return name;
+}
+
+nlohmann::json ScoresJson(const FrameScores& scores) {
+  nlohmann::json json;
+  if (scores.frame >= 0) json["frame"] = scores.frame;
+  json["accuracy"] = scores.surface.accuracy;
+  json["completeness"] = scores.surface.completeness;
+  json["chamfer"] = scores.surface.chamfer;
+  json["hausdorff"] = scores.surface.hausdorff;
+  json["mean_result_to_truth"] = scores.surface.mean_result_to_truth;
+  json["mean_truth_to_result"] = scores.surface.mean_truth_to_result;
+  if (scores.flow.evaluated) {
+    json["flow"] = {{"epe_mean", scores.flow.epe_mean},
+                    {"epe_median", scores.flow.epe_median},
+                    {"true_motion_mean", scores.flow.true_motion_mean},
+                    {"epe_relative", scores.flow.epe_relative}};
+  } else {
+    json["flow"] = nullptr;
+  }
+  return json;
+}
+
+std::string ScoresLine(const std::string& label, const FrameScores& s) {
+  char line[256];
+  std::snprintf(line, sizeof(line), "%-8s %11.4g %8.4f %11.4g %11.4g", label.c_str(), s.surface.accuracy,
+                s.surface.completeness, s.surface.chamfer, s.surface.hausdorff);
+  std::string text = line;
+  if (s.flow.evaluated) {
+    std::snprintf(line, sizeof(line), " %11.4g %11.4g %11.4g %8.4f", s.flow.epe_mean, s.flow.epe_median,
+                  s.flow.true_motion_mean, s.flow.epe_relative);
+  } else {
+    std::snprintf(line, sizeof(line), " %11s %11s %11s %8s", "-", "-", "-", "-");
+  }
+  return text + line + "\n";
+}
+
+}  // namespace
+
+std::vector<std::string> ListFrameMeshes(const std::string& directory) {
+  std::error_code error;
+  if (!fs::is_directory(directory, error))
+    ThrowError(directory, "", "missing (expected a directory of <frame>.ply meshes, 000000.ply …)");
+  const std::regex frame_pattern("^([0-9]{6})\\.ply$");
+  std::vector<int> frames;
+  for (const auto& entry : fs::directory_iterator(directory)) {
+    std::smatch match;
+    const std::string name = entry.path().filename().string();
+    if (std::regex_match(name, match, frame_pattern)) frames.push_back(std::stoi(match[1]));
+  }
+  if (frames.empty()) ThrowError(directory, "", "no frame meshes (expected 000000.ply, 000001.ply, …)");
+  std::sort(frames.begin(), frames.end());
+  std::vector<std::string> paths;
+  for (int f = 0; f < static_cast<int>(frames.size()); ++f) {
+    if (frames[f] != f)
+      ThrowError((fs::path(directory) / FrameFileName(f)).string(), "frame " + std::to_string(f),
+                 "missing (frames must be contiguous from 000000; found up to " +
+                     FrameFileName(frames.back()) + ")");
+    paths.push_back((fs::path(directory) / FrameFileName(f)).string());
+  }
+  return paths;
+}
+
+EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
+                                        const std::string& result_directory,
+                                        const EvaluationOptions& options, Progress* progress) {
+  options.Check();
+  const std::string truth_directory = (fs::path(dataset_directory) / "groundtruth" / "mesh").string();
+  const std::string result_meshes = (fs::path(result_directory) / "meshes").string();
+  const std::vector<std::string> truth_paths = ListFrameMeshes(truth_directory);
+  const std::vector<std::string> result_paths = ListFrameMeshes(result_meshes);
+  if (truth_paths.size() != result_paths.size())
+    ThrowError(result_meshes, "frame count",
+               std::to_string(result_paths.size()) + " frames, but the ground truth (" + truth_directory +
+                   ") has " + std::to_string(truth_paths.size()));
+  geometry::MeshReadOptions read_options;
+  read_options.require_manifold = false;  // scoring does not need manifold meshes
+  auto load_truth = [&](int f) { return geometry::ReadMesh(truth_paths[f], read_options); };
+  auto load_result = [&](int f) {
+    geometry::VertexProperties properties;
+    EvaluationFrame frame;
+    frame.mesh = geometry::ReadMesh(result_paths[f], read_options, &properties);
+    const bool has_any = properties.values.count("vx") || properties.values.count("vy") ||
+                         properties.values.count("vz");
+    if (has_any) {
+      geometry::Positions motion(frame.mesh.V.rows(), 3);
+      const char* names[3] = {"vx", "vy", "vz"};
+      for (int k = 0; k < 3; ++k) {
+        const auto found = properties.values.find(names[k]);
+        if (found == properties.values.end())
+          ThrowError(result_paths[f], names[k], "missing (vx, vy, vz must be given together)");
+        if (found->second.size() != frame.mesh.V.rows())
+          ThrowError(result_paths[f], names[k], "expected one value per vertex");
+        motion.col(k) = found->second;
+      }
+      frame.motion = std::move(motion);
+    }
+    return frame;
+  };
+  return EvaluateSequence(static_cast<int>(truth_paths.size()), load_truth, load_result, options, progress,
+                          truth_directory, result_meshes);
+}
+
+std::string EvaluationReport::Table() const {
+  char header[512];
+  std::snprintf(header, sizeof(header), "%-8s %11s %8s %11s %11s %11s %11s %11s %8s\n", "frame",
+                ("accuracy" + std::to_string(static_cast<int>(accuracy_percentile))).c_str(), "complete",
+                "chamfer", "hausdorff", "epe_mean", "epe_median", "true_mean", "epe_rel");
+  std::string table = header;
+  for (const FrameScores& frame : frames) table += ScoresLine(FrameFileName(frame.frame).substr(0, 6), frame);
+  table += ScoresLine("overall", overall);
+  char footer[256];
+  std::snprintf(footer, sizeof(footer),
+                "completeness threshold %.4g; %d samples per surface and frame; flow from %s\n", threshold,
+                samples, flow_source.c_str());
+  return table + footer;
+}
+
+std::string EvaluationReport::Json() const {
+  nlohmann::json json;
+  json["threshold"] = threshold;
+  json["samples"] = samples;
+  json["accuracy_percentile"] = accuracy_percentile;
+  json["flow_source"] = flow_source;
+  json["overall"] = ScoresJson(overall);
+  json["frames"] = nlohmann::json::array();
+  for (const FrameScores& frame : frames) json["frames"].push_back(ScoresJson(frame));
+  return json.dump(2);
+}
+
+}  // namespace subflow::vision

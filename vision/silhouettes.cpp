@@ -1,0 +1,267 @@
+#include "vision/silhouettes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "geometry/error.h"
+
+namespace subflow::vision {
+namespace {
+
+void CheckRange(bool ok, const char* field, const std::string& expected, double value) {
+  if (!ok)
+    ThrowError("SilhouetteOptions", field,
+               "expected " + expected + ", got " + std::to_string(value));
+}
+
+// CV_32F in [0, 1] with the same channel count.
+cv::Mat ToUnitFloat(const cv::Mat& image) {
+  double scale = 1.0;
+  if (image.depth() == CV_8U) scale = 1.0 / 255.0;
+  else if (image.depth() == CV_16U) scale = 1.0 / 65535.0;
+  else if (image.depth() != CV_32F)
+    ThrowError("", "image", "expected CV_8U, CV_16U or CV_32F pixels");
+  cv::Mat result;
+  image.convertTo(result, CV_32F, scale);
+  if (result.channels() == 4) cv::cvtColor(result, result, cv::COLOR_BGRA2BGR);
+  return result;
+}
+
+void FillHoles(cv::Mat* mask) {
+  // Background reachable from the image border stays background; the rest is a hole.
+  cv::Mat padded;
+  cv::copyMakeBorder(*mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::floodFill(padded, cv::Point(0, 0), cv::Scalar(128));
+  const cv::Mat inner = padded(cv::Rect(1, 1, mask->cols, mask->rows));
+  mask->setTo(255, inner != 128);
+}
+
+void RemoveSmallRegions(cv::Mat* mask, int min_pixels) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(*mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<uint8_t> keep(count, 0);
+  for (int label = 1; label < count; ++label)
+    keep[label] = stats.at<int>(label, cv::CC_STAT_AREA) >= min_pixels;
+  for (int y = 0; y < mask->rows; ++y) {
+    const int* label_row = labels.ptr<int>(y);
+    uint8_t* row = mask->ptr<uint8_t>(y);
+    for (int x = 0; x < mask->cols; ++x)
+      if (row[x] && !keep[label_row[x]]) row[x] = 0;
+  }
+}
+
+cv::Mat Smooth(const cv::Mat& gray, double sigma) {
+  if (sigma <= 0) return gray;
+  cv::Mat smoothed;
+  cv::GaussianBlur(gray, smoothed, cv::Size(), sigma, sigma, cv::BORDER_REPLICATE);
+  return smoothed;
+}
+
+double AutomaticThreshold(const cv::Mat& measure, double fixed, double minimum) {
+  return fixed >= 0 ? fixed : std::max(OtsuThreshold(measure), minimum);
+}
+
+}  // namespace
+
+std::string ToString(EvidenceSource source) {
+  switch (source) {
+    case EvidenceSource::kAuto: return "auto";
+    case EvidenceSource::kMask: return "mask";
+    case EvidenceSource::kBackground: return "background";
+    case EvidenceSource::kMotion: return "motion";
+  }
+  return "?";
+}
+
+EvidenceSource ParseEvidenceSource(const std::string& text, const std::string& field) {
+  for (EvidenceSource source : {EvidenceSource::kAuto, EvidenceSource::kMask,
+                                EvidenceSource::kBackground, EvidenceSource::kMotion})
+    if (text == ToString(source)) return source;
+  ThrowError("", field, "expected auto, mask, background or motion, got \"" + text + "\"");
+}
+
+void SilhouetteOptions::Check() const {
+  CheckRange(background_blur_sigma >= 0 && background_blur_sigma <= 50, "background_blur_sigma",
+             "a value in [0, 50] pixels", background_blur_sigma);
+  CheckRange(background_threshold < 1, "background_threshold",
+             "a value below 1 (negative = automatic)", background_threshold);
+  CheckRange(background_min_threshold >= 0 && background_min_threshold < 1,
+             "background_min_threshold", "a value in [0, 1)", background_min_threshold);
+  CheckRange(motion_sigma >= 0 && motion_sigma <= 50, "motion_sigma", "a value in [0, 50] pixels",
+             motion_sigma);
+  CheckRange(motion_lambda > 0 && std::isfinite(motion_lambda), "motion_lambda",
+             "a positive value", motion_lambda);
+  CheckRange(motion_window >= 0 && motion_window <= 100, "motion_window",
+             "an integer in [0, 100]", motion_window);
+  CheckRange(std::isfinite(motion_threshold), "motion_threshold",
+             "a finite value (negative = automatic)", motion_threshold);
+  CheckRange(motion_min_threshold >= 0 && std::isfinite(motion_min_threshold),
+             "motion_min_threshold", "a non-negative value", motion_min_threshold);
+  CheckRange(close_radius >= 0 && close_radius <= 100, "close_radius",
+             "an integer in [0, 100] pixels", close_radius);
+  CheckRange(min_region_pixels >= 0, "min_region_pixels", "a non-negative integer",
+             min_region_pixels);
+  CheckRange(min_object_pixels >= 1, "min_object_pixels", "a positive integer",
+             min_object_pixels);
+}
+
+double OtsuThreshold(const cv::Mat& values) {
+  SUBFLOW_CHECK(values.type() == CV_32FC1, "OtsuThreshold expects CV_32FC1");
+  std::vector<float> finite;
+  finite.reserve(values.total());
+  for (int y = 0; y < values.rows; ++y) {
+    const float* row = values.ptr<float>(y);
+    for (int x = 0; x < values.cols; ++x)
+      if (std::isfinite(row[x])) finite.push_back(row[x]);
+  }
+  if (finite.empty()) return 0.0;
+  const double lo = *std::min_element(finite.begin(), finite.end());
+  // The top of the histogram is a high percentile, not the maximum, so that a few
+  // outliers do not squeeze the object's values into the lowest bins.
+  std::vector<float> sorted = finite;
+  const size_t top = std::min(sorted.size() - 1, static_cast<size_t>(0.999 * sorted.size()));
+  std::nth_element(sorted.begin(), sorted.begin() + top, sorted.end());
+  double hi = sorted[top];
+  if (!(hi > lo)) hi = *std::max_element(finite.begin(), finite.end());
+  if (!(hi > lo)) return lo;
+  constexpr int kBins = 256;
+  std::vector<double> histogram(kBins, 0.0);
+  const double bin_width = (hi - lo) / kBins;
+  for (float v : finite) {
+    const int bin = std::clamp(static_cast<int>((v - lo) / bin_width), 0, kBins - 1);
+    histogram[bin] += 1.0;
+  }
+  const double total = static_cast<double>(finite.size());
+  double sum_all = 0;
+  for (int b = 0; b < kBins; ++b) sum_all += b * histogram[b];
+  double weight_low = 0, sum_low = 0, best_variance = -1;
+  int best_bin = 0;
+  for (int b = 0; b < kBins - 1; ++b) {
+    weight_low += histogram[b];
+    sum_low += b * histogram[b];
+    const double weight_high = total - weight_low;
+    if (weight_low == 0 || weight_high == 0) continue;
+    const double mean_low = sum_low / weight_low;
+    const double mean_high = (sum_all - sum_low) / weight_high;
+    const double variance = weight_low * weight_high * (mean_low - mean_high) * (mean_low - mean_high);
+    if (variance > best_variance) {
+      best_variance = variance;
+      best_bin = b;
+    }
+  }
+  // The classes are {bins ≤ best_bin} and {bins > best_bin}: threshold at the bin's top edge.
+  return lo + (best_bin + 1) * bin_width;
+}
+
+Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
+                             const SilhouetteOptions& options) {
+  SUBFLOW_CHECK(measure.type() == CV_32FC1, "ThresholdAndClean expects CV_32FC1");
+  Silhouette silhouette;
+  silhouette.measure = measure;
+  silhouette.threshold = threshold;
+  cv::Mat mask = measure > threshold;  // CV_8U 0 / 255
+  if (options.close_radius > 0) {
+    const int size = 2 * options.close_radius + 1;
+    const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(size, size));
+    cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, disk);
+  }
+  if (options.min_region_pixels > 1) RemoveSmallRegions(&mask, options.min_region_pixels);
+  if (options.fill_holes) FillHoles(&mask);
+  silhouette.mask = mask;
+  mask.convertTo(silhouette.evidence, CV_32F, 1.0 / 255.0);
+  silhouette.object_pixels = cv::countNonZero(mask);
+  silhouette.empty = silhouette.object_pixels < options.min_object_pixels;
+  return silhouette;
+}
+
+Silhouette SilhouetteFromMask(const cv::Mat& mask, const SilhouetteOptions& options) {
+  if (mask.empty() || mask.type() != CV_8UC1)
+    ThrowError("", "mask", "expected a non-empty CV_8UC1 image");
+  Silhouette silhouette;
+  silhouette.source = EvidenceSource::kMask;
+  silhouette.mask = mask != 0;
+  silhouette.mask.convertTo(silhouette.evidence, CV_32F, 1.0 / 255.0);
+  silhouette.measure = silhouette.evidence;
+  silhouette.threshold = 0.5;
+  silhouette.object_pixels = cv::countNonZero(silhouette.mask);
+  silhouette.empty = silhouette.object_pixels < options.min_object_pixels;
+  return silhouette;
+}
+
+cv::Mat BackgroundDifference(const cv::Mat& image, const cv::Mat& background) {
+  if (image.empty() || image.size() != background.size() || image.type() != background.type())
+    ThrowError("", "background",
+               "expected an image of the same size and type as the frame, got " +
+                   std::to_string(background.cols) + "×" + std::to_string(background.rows) +
+                   " vs " + std::to_string(image.cols) + "×" + std::to_string(image.rows));
+  const cv::Mat a = ToUnitFloat(image), b = ToUnitFloat(background);
+  cv::Mat difference = a - b;
+  difference = difference.mul(difference);
+  cv::Mat squared;
+  if (difference.channels() == 1) {
+    squared = difference;
+  } else {
+    cv::transform(difference, squared, cv::Matx13f(1.f, 1.f, 1.f) * (1.f / 3.f));
+  }
+  cv::Mat distance;
+  cv::sqrt(squared, distance);
+  return distance;
+}
+
+Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& background,
+                                    const SilhouetteOptions& options) {
+  const cv::Mat measure = Smooth(BackgroundDifference(image, background),
+                                 options.background_blur_sigma);
+  const double threshold = AutomaticThreshold(measure, options.background_threshold,
+                                              options.background_min_threshold);
+  Silhouette silhouette = ThresholdAndClean(measure, threshold, options);
+  silhouette.source = EvidenceSource::kBackground;
+  return silhouette;
+}
+
+cv::Mat MotionEvidence(const std::vector<cv::Mat>& gray_frames, int index,
+                       const SilhouetteOptions& options) {
+  const int count = static_cast<int>(gray_frames.size());
+  if (count < 2)
+    ThrowError("", "motion evidence", "expected at least 2 frames, got " + std::to_string(count));
+  SUBFLOW_CHECK(index >= 0 && index < count, "frame index outside the sequence");
+  for (const cv::Mat& frame : gray_frames)
+    if (frame.type() != CV_32FC1 || frame.size() != gray_frames[0].size())
+      ThrowError("", "motion evidence", "expected CV_32FC1 gray frames of one size");
+  const int first = std::max(0, index - options.motion_window);
+  const int last = std::min(count - 1, index + options.motion_window);
+  // Smoothed frames g − 1 .. g + 1 for every g of the window.
+  const int smooth_first = std::max(0, first - 1), smooth_last = std::min(count - 1, last + 1);
+  std::vector<cv::Mat> smoothed(count);
+  for (int g = smooth_first; g <= smooth_last; ++g)
+    smoothed[g] = Smooth(gray_frames[g], options.motion_sigma);
+
+  cv::Mat accumulated = cv::Mat::zeros(gray_frames[0].size(), CV_32F);
+  for (int g = first; g <= last; ++g) {
+    const int before = std::max(0, g - 1), after = std::min(count - 1, g + 1);
+    cv::Mat dt = (smoothed[after] - smoothed[before]) / static_cast<double>(after - before);
+    cv::Mat dx, dy;
+    cv::Sobel(smoothed[g], dx, CV_32F, 1, 0, 1, 0.5, 0, cv::BORDER_REPLICATE);
+    cv::Sobel(smoothed[g], dy, CV_32F, 0, 1, 1, 0.5, 0, cv::BORDER_REPLICATE);
+    cv::Mat denominator = dx.mul(dx) + dy.mul(dy) + options.motion_lambda;
+    cv::Mat theta;
+    cv::divide(cv::abs(dt), denominator, theta);
+    cv::max(accumulated, theta, accumulated);
+  }
+  return accumulated;
+}
+
+Silhouette SilhouetteFromMotion(const std::vector<cv::Mat>& gray_frames, int index,
+                                const SilhouetteOptions& options) {
+  const cv::Mat measure = MotionEvidence(gray_frames, index, options);
+  const double threshold =
+      AutomaticThreshold(measure, options.motion_threshold, options.motion_min_threshold);
+  Silhouette silhouette = ThresholdAndClean(measure, threshold, options);
+  silhouette.source = EvidenceSource::kMotion;
+  return silhouette;
+}
+
+}  // namespace subflow::vision

@@ -1,0 +1,158 @@
+// Object evidence per camera and frame (method §4.1): a silhouette of the object in each
+// image, from the best source the dataset offers, in this order:
+//
+//  1. kMask        given masks (masks/<camera>/<frame>.png): evidence = mask / 255.
+//  2. kBackground  the difference to the background image: per-pixel distance
+//                  d(p) = sqrt(Σ_c (I_c(p) − B_c(p))² / C) over the C colour channels of
+//                  intensities in [0, 1] (gray: |I − B|), Gaussian-blurred, thresholded
+//                  (Otsu on d, or a fixed value), then cleaned (2D closing, holes filled).
+//  3. kMotion      motion evidence, method eq. 23, per pixel and frame g:
+//                      θ_g(p) = |∂I/∂t(p)| / (λ + ‖∇I(p)‖²)
+//                  with I the Gaussian-smoothed gray image (σ = motion_sigma), ∇I central
+//                  differences in space (intensity / pixel), ∂I/∂t central differences in
+//                  time over frames g−1, g+1 (one-sided at the first and last frame;
+//                  intensity / frame). A point that does not move between one pair of
+//                  frames gives no evidence there, so θ is accumulated (maximum) over the
+//                  window g ∈ [f − w, f + w]; then thresholded (Otsu or fixed) and cleaned
+//                  as above: the thresholded θ marks moving texture and contours, the
+//                  cleaning turns that into a filled silhouette.
+//
+// Conventions: images are in RAW image coordinates (as stored, lens distortion not
+// removed); pixel (0, 0) is the centre of the top-left pixel (DATASET.md). Whoever
+// projects 3D points onto these silhouettes must therefore use Camera::Project (with
+// distortion), not ProjectUndistorted — voxel carving does.
+//
+// Intensities are gray CV_32F in [0, 1] (Dataset::Gray); thresholds of the background
+// difference are in those units; θ is in (intensity / frame) / (intensity / pixel)².
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace subflow::vision {
+
+class Dataset;
+
+enum class EvidenceSource {
+  kAuto,        // options only: masks if the dataset has them, else background, else motion
+  kMask,
+  kBackground,
+  kMotion,
+};
+// "auto", "mask", "background", "motion" (as written in report.json and read by the CLI).
+std::string ToString(EvidenceSource source);
+// Inverse of ToString; throws subflow::Error naming `field` on anything else.
+EvidenceSource ParseEvidenceSource(const std::string& text, const std::string& field = "source");
+
+struct SilhouetteOptions {
+  // Which evidence to use. kAuto takes, per camera, the first of mask / background /
+  // motion that the dataset offers; a forced source that the dataset lacks is an error.
+  EvidenceSource source = EvidenceSource::kAuto;
+
+  // --- background difference ---
+  // σ (pixels) of the Gaussian blur of the difference image (suppresses pixel noise and
+  // half-pixel edge effects). 0 = no blur.
+  double background_blur_sigma = 1.0;
+  // Threshold on the blurred difference (intensity units, [0, 1]); < 0 = automatic
+  // (Otsu on the difference image, but never below background_min_threshold).
+  double background_threshold = -1.0;
+  // Lower bound of the automatic threshold: differences below this are always noise
+  // (0.02 ≈ 5 gray levels of an 8-bit image). Keeps Otsu from splitting pure noise when
+  // the object is absent.
+  double background_min_threshold = 0.02;
+
+  // --- motion evidence (eq. 23) ---
+  // σ (pixels) of the spatial Gaussian smoothing before the derivatives.
+  double motion_sigma = 1.0;
+  // λ of eq. 23, in (intensity / pixel)²: θ peaks where ‖∇I‖ ≈ √λ; it keeps θ defined on
+  // flat regions. 1e-3 ↔ gradients of ~0.03 per pixel (8 gray levels per pixel).
+  double motion_lambda = 1e-3;
+  // Half-width w of the temporal window: θ is accumulated over frames f−w .. f+w
+  // (clipped to the sequence). Larger windows fill in points that pause.
+  int motion_window = 2;
+  // Threshold on the accumulated θ; < 0 = automatic (Otsu, never below
+  // motion_min_threshold).
+  double motion_threshold = -1.0;
+  // Lower bound of the automatic motion threshold (θ units). A static scene gives θ = 0
+  // up to image noise; θ below this is no motion.
+  double motion_min_threshold = 0.5;
+
+  // --- cleaning of thresholded background / motion evidence (not of given masks) ---
+  // Radius (pixels) of the 2D morphological closing of the thresholded image (joins
+  // moving texture and contour fragments into one region). 0 = none.
+  int close_radius = 3;
+  // Fill holes of the silhouette (background regions not connected to the image border).
+  // Right for objects without through-holes; turn off for a torus seen through its hole.
+  bool fill_holes = true;
+  // Connected object regions smaller than this many pixels are removed (noise). 0 = keep all.
+  int min_region_pixels = 20;
+
+  // A silhouette with fewer object pixels than this is "empty" (see Silhouette::empty).
+  int min_object_pixels = 1;
+
+  // Throws subflow::Error naming the field when an option is out of range.
+  void Check() const;
+};
+
+// The object evidence of one camera at one frame.
+struct Silhouette {
+  EvidenceSource source = EvidenceSource::kMask;  // the source actually used
+  // CV_32FC1, the camera's size, values in [0, 1]: the evidence voxel carving integrates
+  // over voxel footprints (here the cleaned binary silhouette as 0 / 1).
+  cv::Mat evidence;
+  // CV_8UC1 0 / 255: the silhouette (evidence ≥ 0.5).
+  cv::Mat mask;
+  // CV_32FC1: the raw measure before thresholding (mask / 255, background distance d, or
+  // accumulated θ), for figures and debugging.
+  cv::Mat measure;
+  // Threshold applied to `measure` (0.5 for masks).
+  double threshold = 0.5;
+  int object_pixels = 0;  // non-zero pixels of `mask`
+  bool empty = true;      // object_pixels < options.min_object_pixels
+};
+
+// Otsu's threshold of a CV_32FC1 image: the value t maximizing the between-class
+// variance of {v ≤ t} and {v > t}, from a 256-bin histogram over [0, the 99.9th
+// percentile] (values outside clamped to the end bins). Returns 0 when the image is
+// constant. Non-finite values are ignored.
+double OtsuThreshold(const cv::Mat& values);
+
+// Silhouette from a given mask (CV_8UC1, non-zero = object). No cleaning.
+Silhouette SilhouetteFromMask(const cv::Mat& mask, const SilhouetteOptions& options = {});
+
+// Per-pixel distance d of an image to the background (same size and type; CV_8U,
+// CV_16U or CV_32F in [0, 1]; 1, 3 or 4 channels, alpha ignored), CV_32FC1 in [0, 1],
+// not yet blurred.
+cv::Mat BackgroundDifference(const cv::Mat& image, const cv::Mat& background);
+// Silhouette from the background difference (see the file comment).
+Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& background,
+                                    const SilhouetteOptions& options = {});
+
+// Accumulated motion evidence θ (eq. 23) at frame `index` of a contiguous sequence of
+// gray images (CV_32FC1, [0, 1], all the same size; at least 2 frames): the maximum of
+// θ_g over g ∈ [index − motion_window, index + motion_window] ∩ [0, size − 1].
+cv::Mat MotionEvidence(const std::vector<cv::Mat>& gray_frames, int index,
+                       const SilhouetteOptions& options = {});
+// Silhouette from MotionEvidence (thresholded and cleaned).
+Silhouette SilhouetteFromMotion(const std::vector<cv::Mat>& gray_frames, int index,
+                                const SilhouetteOptions& options = {});
+
+// Thresholds a CV_32FC1 measure (v > threshold → object) and cleans the result as the
+// options say (closing, hole filling, small regions removed); fills every field of the
+// returned Silhouette except `source`.
+Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
+                             const SilhouetteOptions& options);
+
+// Silhouettes of every camera of `dataset` at `frame` (index = camera index), cameras in
+// parallel. Source per camera: options.source, or for kAuto masks if has_masks(), else
+// background if background/<camera>.png exists, else motion. Motion reads the gray
+// frames f − w − 1 .. f + w + 1 (clipped).
+// Throws subflow::Error when a forced source is missing from the dataset, and, when
+// every camera uses motion and every motion silhouette is empty, the error
+// "<dataset>: frame N: no masks, no background, and no motion: cannot find the object".
+std::vector<Silhouette> ComputeSilhouettes(const Dataset& dataset, int frame,
+                                           const SilhouetteOptions& options = {});
+
+}  // namespace subflow::vision

@@ -1,0 +1,258 @@
+#include "vision/voxel_carving.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "geometry/error.h"
+#include "vision/voxel_morphology.h"
+#include "vision/voxel_projection.h"
+
+namespace subflow::vision {
+namespace {
+
+using geometry::ScalarVolume;
+
+// Whether the camera sees any point of a 17³ lattice over the bounds (corners included).
+bool SeesVolume(const Camera& camera, const Bounds& bounds) {
+  constexpr int kSteps = 16;
+  for (int k = 0; k <= kSteps; ++k)
+    for (int j = 0; j <= kSteps; ++j)
+      for (int i = 0; i <= kSteps; ++i)
+        if (ProjectsIntoImage(camera, bounds.min + bounds.Size().cwiseProduct(Eigen::Vector3d(i, j, k) / kSteps)))
+          return true;
+  return false;
+}
+
+struct CarvingCamera {
+  int index = 0;
+  cv::Mat integral;  // CV_64F (h + 1) × (w + 1) summed-area table of the evidence
+};
+
+// Counts, for every voxel, the cameras that see it and support it (hits) or not (misses).
+// Voxels with more than max_misses misses are skipped by later cameras (already carved).
+void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingCamera>& used,
+                  const ScalarVolume& grid, double threshold, int max_misses,
+                  std::vector<uint16_t>* hits, std::vector<uint16_t>* misses) {
+  const size_t row = grid.nx + 1, plane = row * (grid.ny + 1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, grid.nz, 4), [&](const tbb::blocked_range<int>& range) {
+    std::vector<float> us, vs;
+    for (const CarvingCamera& carving_camera : used) {
+      const Camera& camera = cameras[carving_camera.index];
+      const int width = camera.width(), height = camera.height();
+      const double* sums = carving_camera.integral.ptr<double>();
+      const size_t stride = width + 1;
+      const VoxelCornerProjector projector(camera, grid);
+      us.resize(plane * (range.size() + 1));
+      vs.resize(us.size());
+      for (int k = range.begin(); k <= range.end(); ++k)
+        projector.ProjectPlane(k, &us[(k - range.begin()) * plane], &vs[(k - range.begin()) * plane]);
+      for (int k = range.begin(); k < range.end(); ++k)
+        for (int j = 0; j < grid.ny; ++j)
+          for (int i = 0; i < grid.nx; ++i) {
+            const size_t voxel = grid.Index(i, j, k);
+            if ((*misses)[voxel] > max_misses) continue;
+            const size_t c0 = (k - range.begin()) * plane + j * row + i;
+            const size_t corners[8] = {c0,         c0 + 1,         c0 + row,         c0 + row + 1,
+                                       c0 + plane, c0 + plane + 1, c0 + plane + row, c0 + plane + row + 1};
+            float x_min = us[c0], x_max = us[c0], y_min = vs[c0], y_max = vs[c0];
+            for (size_t c : corners) {
+              x_min = std::min(x_min, us[c]);
+              x_max = std::max(x_max, us[c]);
+              y_min = std::min(y_min, vs[c]);
+              y_max = std::max(y_max, vs[c]);
+            }
+            if (!(x_min >= -0.5f && y_min >= -0.5f && x_max < width - 0.5f && y_max < height - 0.5f))
+              continue;  // not seen: partly outside the image or behind the camera
+            // Pixels whose centres lie in the footprint; the nearest one if none does.
+            int x0 = static_cast<int>(std::ceil(x_min)), x1 = static_cast<int>(std::floor(x_max));
+            int y0 = static_cast<int>(std::ceil(y_min)), y1 = static_cast<int>(std::floor(y_max));
+            if (x0 > x1) x0 = x1 = std::clamp(static_cast<int>(std::lround(0.5f * (x_min + x_max))), 0, width - 1);
+            if (y0 > y1) y0 = y1 = std::clamp(static_cast<int>(std::lround(0.5f * (y_min + y_max))), 0, height - 1);
+            const double sum = sums[(y1 + 1) * stride + x1 + 1] - sums[y0 * stride + x1 + 1] -
+                               sums[(y1 + 1) * stride + x0] + sums[y0 * stride + x0];
+            const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
+            if (sum >= threshold * area) ++(*hits)[voxel];
+            else ++(*misses)[voxel];
+          }
+    }
+  });
+}
+
+std::string FrameLabel(int frame) { return "frame " + std::to_string(frame); }
+
+void Warn(CarvingResult* result, const std::string& message) {
+  spdlog::warn("{}", message);
+  result->warnings.push_back(message);
+}
+
+}  // namespace
+
+void VoxelCarvingOptions::Check() const {
+  auto fail = [](const char* field, const std::string& expected, double value) {
+    ThrowError("VoxelCarvingOptions", field, "expected " + expected + ", got " + std::to_string(value));
+  };
+  if (resolution < 0 || resolution > 2048) fail("resolution", "0 (automatic) or 1..2048", resolution);
+  if (!(pixels_per_voxel > 0 && pixels_per_voxel <= 1000)) fail("pixels_per_voxel", "a value in (0, 1000]", pixels_per_voxel);
+  if (max_auto_resolution < 8 || max_auto_resolution > 2048) fail("max_auto_resolution", "8..2048", max_auto_resolution);
+  if (min_cameras < 1) fail("min_cameras", "at least 1", min_cameras);
+  if (max_misses < -1) fail("max_misses", "-1 (automatic) or ≥ 0", max_misses);
+  if (!(evidence_threshold > 0 && evidence_threshold <= 1)) fail("evidence_threshold", "a value in (0, 1]", evidence_threshold);
+  if (closing_radius < 0 || closing_radius > 32) fail("closing_radius", "0..32 voxels", closing_radius);
+  if (opening_radius < 0 || opening_radius > 32) fail("opening_radius", "0..32 voxels", opening_radius);
+  if (connectivity != 6 && connectivity != 26) fail("connectivity", "6 or 26", connectivity);
+  if (!(min_component_fraction >= 0 && min_component_fraction <= 1)) fail("min_component_fraction", "a value in [0, 1]", min_component_fraction);
+  if (threads < 0) fail("threads", "0 (all) or a positive count", threads);
+}
+
+int ChooseResolution(const std::vector<Camera>& cameras, const Bounds& bounds,
+                     const VoxelCarvingOptions& options) {
+  if (options.resolution > 0) return options.resolution;
+  double finest = 0;  // pixels per world unit at the centre, best camera
+  for (const Camera& camera : cameras) {
+    const Eigen::Vector3d centre = bounds.Center();
+    if (!ProjectsIntoImage(camera, centre)) continue;
+    const double focal = 0.5 * (camera.K()(0, 0) + camera.K()(1, 1));
+    finest = std::max(finest, focal / camera.ToCamera(centre).z());
+  }
+  if (finest <= 0) return options.max_auto_resolution;
+  const double spacing = options.pixels_per_voxel / finest;
+  const double voxels = std::ceil(bounds.Size().maxCoeff() / spacing);
+  return static_cast<int>(std::clamp(voxels, 8.0, static_cast<double>(options.max_auto_resolution)));
+}
+
+ScalarVolume MakeVoxelGrid(const Bounds& bounds, int resolution) {
+  if (!bounds.IsValid()) ThrowError("", "bounds", "expected min < max (finite) on every axis");
+  SUBFLOW_CHECK(resolution >= 1, "resolution must be positive");
+  const double spacing = bounds.Size().maxCoeff() / resolution;
+  Eigen::Vector3i counts;
+  for (int a = 0; a < 3; ++a)
+    counts[a] = std::max(1, static_cast<int>(std::ceil(bounds.Size()[a] / spacing - 1e-9)));
+  const Eigen::Vector3d origin = bounds.Center() - 0.5 * spacing * (counts.cast<double>() - Eigen::Vector3d::Ones());
+  return ScalarVolume(origin, spacing, counts[0], counts[1], counts[2], 0.0f);
+}
+
+CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
+                          const std::vector<Silhouette>& silhouettes, const Bounds& bounds,
+                          const VoxelCarvingOptions& options, int frame) {
+  options.Check();
+  const std::string where = FrameLabel(frame);
+  if (silhouettes.size() != cameras.size())
+    ThrowError(where, "silhouettes", "expected one per camera (" + std::to_string(cameras.size()) +
+                                         "), got " + std::to_string(silhouettes.size()));
+  if (!bounds.IsValid()) ThrowError(where, "bounds", "expected min < max (finite) on every axis");
+
+  CarvingResult result;
+  result.frame = frame;
+  std::vector<CarvingCamera> used;
+  int empty_count = 0, seeing_count = 0;
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    const Camera& camera = cameras[c];
+    const Silhouette& silhouette = silhouettes[c];
+    CameraCarvingReport report;
+    report.name = camera.name();
+    report.source = silhouette.source;
+    report.object_pixels = silhouette.object_pixels;
+    if (silhouette.evidence.type() != CV_32FC1 || silhouette.evidence.cols != camera.width() ||
+        silhouette.evidence.rows != camera.height())
+      ThrowError(where, "camera \"" + camera.name() + "\": silhouette",
+                 "expected a CV_32FC1 evidence image of " + std::to_string(camera.width()) + "×" +
+                     std::to_string(camera.height()) + " pixels");
+    if (!SeesVolume(camera, bounds)) {
+      report.excluded = "sees nothing of the working volume";
+      Warn(&result, where + ": camera \"" + camera.name() +
+                        "\" sees nothing of the working volume: excluded");
+    } else if (silhouette.empty) {
+      ++seeing_count;
+      ++empty_count;
+      report.excluded = "empty silhouette";
+      Warn(&result, where + ": camera \"" + camera.name() + "\" has an empty silhouette (" +
+                        ToString(silhouette.source) +
+                        "): excluded, it would carve away every voxel it sees");
+    } else {
+      ++seeing_count;
+      report.used = true;
+      CarvingCamera carving_camera;
+      carving_camera.index = static_cast<int>(c);
+      cv::integral(silhouette.evidence, carving_camera.integral, CV_64F);
+      used.push_back(std::move(carving_camera));
+    }
+    result.cameras.push_back(report);
+  }
+  if (seeing_count == 0)
+    ThrowError(where, "cameras", "no camera sees the working volume: nothing can be carved");
+  if (used.empty())
+    ThrowError(where, "silhouettes", "every camera's silhouette is empty (" +
+                                         std::to_string(empty_count) + " cameras): cannot find the object");
+  if (static_cast<int>(used.size()) < options.min_cameras)
+    ThrowError(where, "cameras", "only " + std::to_string(used.size()) +
+                                     " camera(s) usable, min_cameras = " + std::to_string(options.min_cameras));
+
+  bool all_masks = true;
+  for (const CarvingCamera& c : used) all_masks = all_masks && silhouettes[c.index].source == EvidenceSource::kMask;
+  result.max_misses = options.max_misses >= 0 ? options.max_misses : (all_masks ? 0 : 1);
+  result.resolution = ChooseResolution(cameras, bounds, options);
+  result.occupancy = MakeVoxelGrid(bounds, result.resolution);
+  ScalarVolume& occupancy = result.occupancy;
+
+  BinaryVolume occupied(occupancy.nx, occupancy.ny, occupancy.nz);
+  tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic : options.threads);
+  arena.execute([&] {
+    std::vector<uint16_t> hits(occupancy.size(), 0), misses(occupancy.size(), 0);
+    CountSupport(cameras, used, occupancy, options.evidence_threshold, result.max_misses, &hits, &misses);
+    for (size_t v = 0; v < occupancy.size(); ++v)
+      occupied.values[v] = hits[v] >= options.min_cameras && misses[v] <= result.max_misses;
+    result.carved_voxels = occupied.Count();
+    CloseBox(&occupied, options.closing_radius);
+    OpenBox(&occupied, options.opening_radius);
+    const ComponentSummary components =
+        KeepLargeComponents(&occupied, options.min_component_fraction, options.connectivity);
+    result.components_found = components.found;
+    result.components_kept = components.kept;
+    if (options.fill_cavities) result.cavity_voxels_filled = FillCavities(&occupied, options.connectivity);
+    occupied.CopyTo(&occupancy);
+    if (options.compute_silhouette_iou) {
+      tbb::parallel_for(size_t(0), used.size(), [&](size_t u) {
+        const int c = used[u].index;
+        const cv::Mat mask = silhouettes[c].mask.type() == CV_8UC1 &&
+                                     silhouettes[c].mask.size() == silhouettes[c].evidence.size()
+                                 ? silhouettes[c].mask
+                                 : cv::Mat(silhouettes[c].evidence >= 0.5f);
+        result.cameras[c].silhouette_iou = SilhouetteIoU(ProjectOccupancy(cameras[c], occupancy), mask);
+      });
+    }
+  });
+
+  result.occupied_voxels = occupied.Count();
+  if (result.occupied_voxels == 0)
+    Warn(&result, where + ": no voxel is occupied: the silhouettes do not agree on any object");
+  for (int k = 0; k < occupancy.nz; ++k)
+    for (int j = 0; j < occupancy.ny; ++j)
+      for (int i = 0; i < occupancy.nx; ++i) {
+        if (occupancy.at(i, j, k) <= 0.5f) continue;
+        result.border_voxels[0] += i == 0, result.border_voxels[1] += i == occupancy.nx - 1;
+        result.border_voxels[2] += j == 0, result.border_voxels[3] += j == occupancy.ny - 1;
+        result.border_voxels[4] += k == 0, result.border_voxels[5] += k == occupancy.nz - 1;
+      }
+  static const char* kSides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  for (int side = 0; side < 6; ++side)
+    if (result.border_voxels[side] > 0)
+      Warn(&result, where + ": the object touches the " + kSides[side] + " side of the working volume (" +
+                        std::to_string(result.border_voxels[side]) +
+                        " voxels): it may extend beyond the bounds");
+  if (options.compute_silhouette_iou) {
+    double sum = 0;
+    for (const CarvingCamera& c : used) sum += result.cameras[c.index].silhouette_iou;
+    result.mean_silhouette_iou = sum / used.size();
+  }
+  return result;
+}
+
+}  // namespace subflow::vision

@@ -1,0 +1,141 @@
+// Evidence voxels in the working volume (method §4.1, eq. 23 integrated over footprints):
+// silhouettes → occupancy of a voxel grid → 3D morphology → connected components.
+//
+// Grid: MakeVoxelGrid covers the working volume (Bounds) with cubic voxels; sample
+// (i, j, k) of the geometry::ScalarVolume is the voxel's centre (see scalar_volume.h).
+// The grid is NOT padded: an object that reaches the bounds touches the grid's border
+// (reported as a warning); an iso-surface extractor should pad with empty voxels.
+//
+// Carving, per voxel V and camera k:
+//   footprint  the bounding box of the 8 projected corners of V, projected with
+//              Camera::Project — WITH lens distortion, because silhouettes are in raw
+//              image coordinates (vision/silhouettes.h);
+//   k sees V   when all 8 corners are in front of the camera (depth > 0; with distortion,
+//              also within the image grown by its size before distortion, where the
+//              polynomial cannot fold back) and the footprint lies inside the image
+//              [−½, w − ½) × [−½, h − ½) (pixel (0, 0) = centre of the top-left pixel);
+//   evidence   e_k(V) = mean of the camera's evidence image over the pixels whose centres
+//              lie in the footprint (summed-area table, cv::integral, O(1) per voxel; the
+//              pixel nearest the footprint's centre when none does);
+//   hit / miss e_k(V) ≥ evidence_threshold / below it.
+// V is occupied ⇔ hits(V) ≥ min_cameras and misses(V) ≤ max_misses. So a voxel is carved
+// only by the cameras that see it (a partial rig works), and a voxel seen by fewer than
+// min_cameras cameras is NOT occupied: one view alone cannot locate anything along its
+// rays, so such voxels (e.g. the corners of the volume outside most frusta) stay empty.
+//
+// Cleaning (in this order): closing then opening with a (2r + 1)³ box, keep connected
+// components with ≥ min_component_fraction × the largest one's voxels, fill interior
+// cavities (vision/voxel_morphology.h).
+//
+// Bad input: a camera that sees nothing of the volume or whose silhouette is empty (it
+// would carve away every voxel it sees) is excluded with a warning naming it (and the
+// frame); when no camera remains, or the remaining ones cannot reach min_cameras, that is
+// an error. An object touching the border of the volume gives a warning naming the frame
+// and the side(s). Warnings are logged (spdlog) and returned in CarvingResult::warnings.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "geometry/scalar_volume.h"
+#include "vision/camera.h"
+#include "vision/silhouettes.h"
+#include "vision/voxel_projection.h"  // ProjectOccupancy, SilhouetteIoU
+#include "vision/working_volume.h"
+
+namespace subflow::vision {
+
+class Dataset;
+
+struct VoxelCarvingOptions {
+  // Voxels along the longest axis of the working volume; 0 = automatic: a voxel projects
+  // to about pixels_per_voxel pixels in the finest camera that sees the volume's centre,
+  // capped at max_auto_resolution.
+  int resolution = 0;
+  // Target footprint (pixels) of one voxel edge for the automatic resolution.
+  double pixels_per_voxel = 2.0;
+  // Cap of the automatic resolution (memory and time grow with its cube).
+  int max_auto_resolution = 160;
+  // A voxel must be seen AND supported (evidence ≥ threshold) by at least this many
+  // cameras to be occupied. 2 = the fewest that triangulate; raise it on dense rigs.
+  int min_cameras = 2;
+  // Cameras that see a voxel but have too little evidence there, tolerated before the
+  // voxel is carved. −1 = automatic: 0 when every used camera's evidence is a given mask
+  // (strict visual hull), else 1 (background and motion silhouettes have holes).
+  int max_misses = -1;
+  // Fraction of a footprint that must be object for a camera to support a voxel. 0.5
+  // puts the hull's boundary on the silhouette cones (lower = larger, more conservative).
+  double evidence_threshold = 0.5;
+  // Radius (voxels) of the closing, then of the opening (box (2r + 1)³); 0 = skip.
+  int closing_radius = 1;
+  int opening_radius = 1;
+  // Connectivity of occupied voxels for components (6 or 26); empty space uses the other.
+  int connectivity = 26;
+  // Components with fewer voxels than this fraction of the largest are removed.
+  double min_component_fraction = 0.1;
+  // Fill interior cavities (empty regions not connected to the volume's border).
+  bool fill_cavities = true;
+  // Compute CameraCarvingReport::silhouette_iou (projects the surface voxels of the
+  // result into every used camera; costs about as much as the carving).
+  bool compute_silhouette_iou = true;
+  // Worker threads (TBB); 0 = all available, 1 = serial (e.g. for a benchmark baseline).
+  int threads = 0;
+
+  // Throws subflow::Error naming the field when an option is out of range.
+  void Check() const;
+};
+
+struct CameraCarvingReport {
+  std::string name;
+  EvidenceSource source = EvidenceSource::kMask;  // where the camera's silhouette came from
+  bool used = false;       // took part in the carving
+  std::string excluded;    // why not, "" when used
+  int object_pixels = 0;   // pixels of the silhouette
+  // |projection of the occupancy ∩ silhouette| / |… ∪ …| over the image (used cameras;
+  // NaN when not computed).
+  double silhouette_iou = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct CarvingResult {
+  int frame = 0;
+  geometry::ScalarVolume occupancy;  // 0 / 1 per voxel, after cleaning
+  int resolution = 0;                // voxels along the longest axis
+  int max_misses = 0;                // the value used (after "automatic")
+  std::size_t carved_voxels = 0;     // occupied straight after carving
+  std::size_t occupied_voxels = 0;   // occupied after cleaning
+  int components_found = 0, components_kept = 0;
+  std::size_t cavity_voxels_filled = 0;
+  // Occupied voxels on the faces −x, +x, −y, +y, −z, +z of the grid (object leaving the bounds).
+  std::array<std::size_t, 6> border_voxels{};
+  std::vector<CameraCarvingReport> cameras;  // one per camera, in input order
+  double mean_silhouette_iou = std::numeric_limits<double>::quiet_NaN();  // over used cameras
+  std::vector<std::string> warnings;
+};
+
+// The voxel count along the longest axis chosen by options.resolution / automatic rule:
+// spacing = pixels_per_voxel / max_k (f_k / depth_k(centre)) over the cameras that see
+// the volume's centre (f_k = (fx + fy) / 2); without any, the cap. Result in [8, cap].
+int ChooseResolution(const std::vector<Camera>& cameras, const Bounds& bounds,
+                     const VoxelCarvingOptions& options);
+
+// An empty grid of cubic voxels of edge L / resolution (L = the longest side of
+// `bounds`), ceil(size / spacing) voxels per axis, centred on the bounds.
+geometry::ScalarVolume MakeVoxelGrid(const Bounds& bounds, int resolution);
+
+// Carves, cleans and measures (see the file comment). silhouettes[k] belongs to
+// cameras[k] and must have its size. `frame` only labels messages and the result.
+CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
+                          const std::vector<Silhouette>& silhouettes, const Bounds& bounds,
+                          const VoxelCarvingOptions& options, int frame = 0);
+
+// ComputeSilhouettes + CarveVoxels on the dataset's cameras and bounds at one frame.
+CarvingResult CarveFrame(const Dataset& dataset, int frame,
+                         const SilhouetteOptions& silhouette_options = {},
+                         const VoxelCarvingOptions& carving_options = {});
+
+}  // namespace subflow::vision
