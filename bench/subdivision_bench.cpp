@@ -14,14 +14,16 @@
 //                           timing (PauseTiming/ResumeTiming).
 //   BM_HierarchyConstruction  the one-time cost of LoopHierarchy (connectivity and all
 //                           operators of levels 0..4), for scale.
-// All single-threaded. Run with
+// CGAL is single-threaded; ours is timed with one TBB thread and with all cores. Run with
 //   subdivision_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <cmath>
+#include <memory>
 
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/subdivision_method_3.h>
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include "geometry/icosphere.h"
 #include "geometry/loop_hierarchy.h"
@@ -67,33 +69,45 @@ const Fixture& GetFixture() {
   return fixture;
 }
 
+// Our loops run in parallel (TBB) over blocks of rows on the finer levels. Argument 1
+// limits TBB to one thread, so those rows compare single thread against single thread;
+// argument 0 lets TBB use every core. Wall-clock time either way (UseRealTime).
+std::unique_ptr<tbb::global_control> ThreadLimit(const benchmark::State& state) {
+  if (state.range(0) == 0) return nullptr;
+  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                               static_cast<size_t>(state.range(0)));
+}
+
 void BM_Resynthesis(benchmark::State& state) {
   const Fixture& f = GetFixture();
+  const auto limit = ThreadLimit(state);
   for (auto _ : state) {
     Positions c = f.shape.Synthesize(f.hierarchy, kLevels);
     benchmark::DoNotOptimize(c.data());
   }
   state.counters["faces"] = f.hierarchy.FaceCount(kLevels);
 }
-BENCHMARK(BM_Resynthesis)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Resynthesis)->ArgName("threads")->Arg(1)->Arg(0)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_Refinement(benchmark::State& state) {
   const Fixture& f = GetFixture();
+  const auto limit = ThreadLimit(state);
   for (auto _ : state) {
     Positions c = f.hierarchy.Refine(f.shape.base(), 0, kLevels);
     benchmark::DoNotOptimize(c.data());
   }
 }
-BENCHMARK(BM_Refinement)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Refinement)->ArgName("threads")->Arg(1)->Arg(0)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_LimitTessellation(benchmark::State& state) {
   const Fixture& f = GetFixture();
+  const auto limit = ThreadLimit(state);
   for (auto _ : state) {
     Positions s = MultiplyPoints(f.hierarchy.LimitPositions(kLevels), f.finest);
     benchmark::DoNotOptimize(s.data());
   }
 }
-BENCHMARK(BM_LimitTessellation)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LimitTessellation)->ArgName("threads")->Arg(1)->Arg(0)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_CgalLoopSubdivision(benchmark::State& state) {
   const Fixture& f = GetFixture();
@@ -118,7 +132,7 @@ void BM_CgalLoopSubdivision(benchmark::State& state) {
     state.ResumeTiming();
   }
 }
-BENCHMARK(BM_CgalLoopSubdivision)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CgalLoopSubdivision)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 void BM_HierarchyConstruction(benchmark::State& state) {
   const Fixture& f = GetFixture();
@@ -127,7 +141,7 @@ void BM_HierarchyConstruction(benchmark::State& state) {
     benchmark::DoNotOptimize(&hierarchy);
   }
 }
-BENCHMARK(BM_HierarchyConstruction)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HierarchyConstruction)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace subflow::geometry

@@ -71,3 +71,5 @@ void BM_RayCastOneCameraReference(benchmark::State& state) {
 BENCHMARK(BM_RayCastOneCameraReference)->Unit(benchmark::kMillisecond);
 
 }  // namespace
+
+BENCHMARK_MAIN();

@@ -11,7 +11,9 @@
 #include <CGAL/Image_3.h>
 #include <CGAL/Labeled_mesh_domain_3.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
+#include <CGAL/Mesh_3/Mesher_3.h>
 #include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_facet_topology.h>
 #include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
@@ -19,7 +21,6 @@
 #include <CGAL/Random.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/facets_in_complex_3_to_triangle_mesh.h>
-#include <CGAL/refine_mesh_3.h>
 
 #include "geometry/error.h"
 #include "geometry/isosurface.h"
@@ -195,11 +196,12 @@ TriangleMesh ExtractIsosurface(const ScalarVolume& volume, const IsosurfaceOptio
                           params::facet_distance = options.facet_distance_voxels * h);
   Complex c3t3;
   InsertSeeds(seeds, domain, &c3t3);
-  CGAL::refine_mesh_3(
-      c3t3, domain, criteria, params::no_perturb(), params::no_exude(), params::manifold(),
-      params::no_reset_c3t3(),
-      params::mesh_3_options(params::maximal_number_of_vertices =
-                                 static_cast<std::size_t>(options.max_vertex_count)));
+  // The engine of CGAL::refine_mesh_3 without its optimizers (ODT, Lloyd, perturbation,
+  // exudation act on cells, which we do not need): instantiating them doubled the compile
+  // time and memory of this file. MANIFOLD is refine_mesh_3's parameters::manifold().
+  CGAL::Mesh_3::Mesher_3<Complex, Criteria, MeshDomain> mesher(
+      c3t3, domain, criteria, CGAL::MANIFOLD, static_cast<std::size_t>(options.max_vertex_count));
+  mesher.refine_mesh();
   stats.mesh_seconds = SecondsSince(start);
 
   start = std::chrono::steady_clock::now();

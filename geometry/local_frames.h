@@ -48,13 +48,13 @@ LocalFrames FramesFromTangents(const Positions& t1, const Positions& t2);
 LocalFrames ComputeLocalFrames(const LoopHierarchy& hierarchy, int level,
                                const Positions& control_points);
 
-// The synthesis step (hot path), fused: points += F d, where F are the frames of `points`
-// themselves at `level` (computed from all of them before any is moved) and d = `local`
-// (#V(level)×3, rows (d_n, d_r, d_q)). Equivalent to
-//   points += ComputeLocalFrames(hierarchy, level, points).ToWorld(local)
-// without materializing the frames.
-void AddDetailsInLocalFrames(const LoopHierarchy& hierarchy, int level, const Positions& local,
-                             Positions* points);
+// The synthesis step (hot path), fused: result = predicted + F d, F the frames of
+// `predicted` at `level` and d = `local` (#V(level)×3, rows (d_n, d_r, d_q)). Equivalent to
+//   predicted + ComputeLocalFrames(hierarchy, level, predicted).ToWorld(local)
+// (same arithmetic) without materializing the frames. `result` must not alias `predicted`.
+void AddDetailsInLocalFrames(const LoopHierarchy& hierarchy, int level,
+                             const Positions& predicted, const Positions& local,
+                             Positions* result);
 
 // Limit normals only (#V×3 unit rows), same convention as LocalFrames::normal.
 Positions LimitNormals(const LoopHierarchy& hierarchy, int level,

@@ -56,6 +56,7 @@ LoopHierarchy::LoopHierarchy(const Faces& base_faces, int vertex_count, int leve
 
   for (int level = 0; level < levels; ++level) {
     refinement_.push_back(LoopRefinementMatrix(topology_[level]));
+    refinement_stencils_.push_back(LoopRefinementStencil(topology_[level]));
     faces_.push_back(SplitFaces(faces_[level], topology_[level]));
     const int next_vertex_count = topology_[level].vertex_count() + topology_[level].edge_count();
     topology_.emplace_back(faces_[level + 1], next_vertex_count,
@@ -65,8 +66,7 @@ LoopHierarchy::LoopHierarchy(const Faces& base_faces, int vertex_count, int leve
     taubin_.push_back(TaubinSmoothingMatrix(topology_[level], taubin));
     limit_positions_.push_back(LoopLimitPositionMatrix(topology_[level]));
     limit_tangents_.push_back(LoopLimitTangentMatrices(topology_[level]));
-    limit_tangent_pairs_.push_back(
-        InterleaveRows(limit_tangents_.back()[0], limit_tangents_.back()[1]));
+    tangent_stencils_.push_back(LoopLimitTangentStencil(topology_[level]));
     if (level > 0) {
       SparseMatrix coarsening = taubin_[level].topRows(topology_[level - 1].vertex_count());
       coarsening.makeCompressed();
@@ -125,7 +125,7 @@ Positions LoopHierarchy::Refine(const Positions& control_points, int from_level,
                 "control points do not match the level's vertex count");
   Positions c = control_points, next;
   for (int level = from_level; level < to_level; ++level) {
-    MultiplyPoints(refinement_[level], c, &next);
+    refinement_stencils_[level].Apply(c, &next);
     c.swap(next);
   }
   return c;

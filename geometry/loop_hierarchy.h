@@ -29,6 +29,7 @@
 
 #include "geometry/loop_operators.h"
 #include "geometry/mesh_topology.h"
+#include "geometry/point_stencil.h"
 #include "geometry/triangle_mesh.h"
 
 namespace subflow::geometry {
@@ -81,13 +82,12 @@ class LoopHierarchy {
   const SparseMatrix& LimitTangent(int level, int which) const {
     return limit_tangents_.at(level).at(which);
   }
-  // T1 and T2 interleaved (2#V(i) × #V(i), row 2v = T1 row v, row 2v + 1 = T2 row v): one
-  // MultiplyPoints gives both tangents of every vertex.
-  const SparseMatrix& LimitTangentPair(int level) const { return limit_tangent_pairs_.at(level); }
+  // Hot-path forms (point_stencil.h): C(i) for 0 ≤ level < n, and [T1, T2] (two channels).
+  const PointStencil& RefinementStencil(int level) const { return refinement_stencils_.at(level); }
+  const PointStencil& LimitTangentStencil(int level) const { return tangent_stencils_.at(level); }
 
   // Control points of `to_level` from control points of `from_level` by repeated
-  // refinement (no details): c(to) = C(to−1) ⋯ C(from) c(from). (Operators are applied
-  // with MultiplyPoints, loop_operators.h, which is faster than Eigen's product here.)
+  // refinement (no details): c(to) = C(to−1) ⋯ C(from) c(from), with the stencils.
   Positions Refine(const Positions& control_points, int from_level, int to_level) const;
 
  private:
@@ -98,7 +98,8 @@ class LoopHierarchy {
   std::vector<SparseMatrix> coarsening_;   // levels 1..n, stored at [level − 1]
   std::vector<SparseMatrix> limit_positions_;
   std::vector<std::array<SparseMatrix, 2>> limit_tangents_;
-  std::vector<SparseMatrix> limit_tangent_pairs_;
+  std::vector<PointStencil> refinement_stencils_;  // levels 0..n−1
+  std::vector<PointStencil> tangent_stencils_;     // levels 0..n
 };
 
 // The faces of the next level (the 1-to-4 split documented above) from level i's faces and

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "geometry/error.h"
+#include "geometry/point_stencil.h"
 
 namespace subflow::geometry {
 namespace {
@@ -91,20 +92,21 @@ void MultiplyPoints(const SparseMatrix& matrix, const Positions& x, Positions* y
   const double* values = matrix.valuePtr();
   const double* in = x.data();
   double* out = y->data();
-  const Eigen::Index rows = matrix.rows();
-  for (Eigen::Index row = 0; row < rows; ++row) {
-    double sx = 0.0, sy = 0.0, sz = 0.0;
-    for (int i = offsets[row]; i < offsets[row + 1]; ++i) {
-      const double w = values[i];
-      const double* p = in + 3 * static_cast<Eigen::Index>(columns[i]);
-      sx += w * p[0];
-      sy += w * p[1];
-      sz += w * p[2];
+  ForEachRowBlock(static_cast<int>(matrix.rows()), [&](int begin, int end) {
+    for (int row = begin; row < end; ++row) {
+      double sx = 0.0, sy = 0.0, sz = 0.0;
+      for (int i = offsets[row]; i < offsets[row + 1]; ++i) {
+        const double w = values[i];
+        const double* p = in + 3 * static_cast<Eigen::Index>(columns[i]);
+        sx += w * p[0];
+        sy += w * p[1];
+        sz += w * p[2];
+      }
+      out[3 * row] = sx;
+      out[3 * row + 1] = sy;
+      out[3 * row + 2] = sz;
     }
-    out[3 * row] = sx;
-    out[3 * row + 1] = sy;
-    out[3 * row + 2] = sz;
-  }
+  });
 }
 
 Positions MultiplyPoints(const SparseMatrix& matrix, const Positions& x) {
@@ -113,60 +115,148 @@ Positions MultiplyPoints(const SparseMatrix& matrix, const Positions& x) {
   return y;
 }
 
-SparseMatrix InterleaveRows(const SparseMatrix& first, const SparseMatrix& second) {
-  SUBFLOW_CHECK(first.rows() == second.rows() && first.cols() == second.cols(),
-                "interleaved matrices differ in shape");
-  const int n = static_cast<int>(first.rows());
-  RowBuilder rows(2 * n, static_cast<int>(first.cols()),
-                  static_cast<size_t>(first.nonZeros() + second.nonZeros()));
-  for (int v = 0; v < n; ++v) {
-    for (const SparseMatrix* matrix : {&first, &second}) {
-      for (SparseMatrix::InnerIterator it(*matrix, v); it; ++it) rows.Add(it.col(), it.value());
-      rows.EndRow();
-    }
-  }
-  return rows.Build();
-}
-
 double LoopAlpha(int valence) {
   const double c = 3.0 + 2.0 * std::cos(2.0 * kPi / valence);
   return 5.0 / 8.0 - c * c / 64.0;
 }
 
-SparseMatrix LoopRefinementMatrix(const MeshTopology& topology) {
+namespace {
+
+// Pattern keys of the stencils: rows with equal keys have equal weights.
+constexpr int kInteriorEvenPattern = 0;     // + valence
+constexpr int kBoundaryEvenPattern = -1;
+constexpr int kInteriorOddPattern = -2;
+constexpr int kBoundaryOddPattern = -3;
+constexpr int kBoundaryTangentPattern = 1000;  // + faces around the boundary vertex
+
+// The rows of C (loop_operators.h), each as sink.Add(column, weight)… sink.EndRow(pattern).
+template <typename Sink>
+void EmitRefinementRows(const MeshTopology& topology, Sink& sink) {
   const int n = topology.vertex_count();
-  const int m = topology.edge_count();
-  RowBuilder rows(n + m, n, static_cast<size_t>(n) * 7 + static_cast<size_t>(m) * 4);
   for (int v = 0; v < n; ++v) {
     CheckReferenced(topology, v);
     const IndexRange ring = topology.Ring(v);
     if (topology.IsBoundaryVertex(v)) {
-      rows.Add(v, 0.75);
-      rows.Add(ring.front(), 0.125);
-      rows.Add(ring.back(), 0.125);
+      sink.Add(v, 0.75);
+      sink.Add(ring.front(), 0.125);
+      sink.Add(ring.back(), 0.125);
+      sink.EndRow(kBoundaryEvenPattern);
     } else {
       const int valence = ring.size();
       const double alpha = LoopAlpha(valence);
-      rows.Add(v, 1.0 - alpha);
-      for (int r : ring) rows.Add(r, alpha / valence);
+      sink.Add(v, 1.0 - alpha);
+      for (int r : ring) sink.Add(r, alpha / valence);
+      sink.EndRow(kInteriorEvenPattern + valence);
     }
-    rows.EndRow();
   }
-  for (int e = 0; e < m; ++e) {
+  for (int e = 0; e < topology.edge_count(); ++e) {
     const int a = topology.EdgeVertex(e, 0), b = topology.EdgeVertex(e, 1);
     if (topology.IsBoundaryEdge(e)) {
-      rows.Add(a, 0.5);
-      rows.Add(b, 0.5);
+      sink.Add(a, 0.5);
+      sink.Add(b, 0.5);
+      sink.EndRow(kBoundaryOddPattern);
     } else {
       const int h = topology.EdgeHalfedge(e);
-      rows.Add(a, 0.375);
-      rows.Add(b, 0.375);
-      rows.Add(topology.HalfedgeOpposite(h), 0.125);
-      rows.Add(topology.HalfedgeOpposite(topology.HalfedgeTwin(h)), 0.125);
+      sink.Add(a, 0.375);
+      sink.Add(b, 0.375);
+      sink.Add(topology.HalfedgeOpposite(h), 0.125);
+      sink.Add(topology.HalfedgeOpposite(topology.HalfedgeTwin(h)), 0.125);
+      sink.EndRow(kInteriorOddPattern);
     }
-    rows.EndRow();
   }
-  return rows.Build();
+}
+
+// The rows of [T1, T2] in ring order, each as sink.Add(column, w1, w2)… sink.EndRow(pattern).
+template <typename Sink>
+void EmitTangentRows(const MeshTopology& topology, Sink& sink) {
+  for (int v = 0; v < topology.vertex_count(); ++v) {
+    CheckReferenced(topology, v);
+    const IndexRange ring = topology.Ring(v);
+    const int valence = ring.size();
+    if (!topology.IsBoundaryVertex(v)) {
+      for (int j = 0; j < valence; ++j) {
+        const double angle = 2.0 * kPi * j / valence;
+        sink.Add(ring[j], std::cos(angle), std::sin(angle));
+      }
+      sink.EndRow(valence);
+      continue;
+    }
+    const int k = valence - 1;  // faces around the boundary vertex
+    std::vector<double> across(valence + 1, 0.0);  // [v, r_0 … r_k]
+    if (k == 1) {
+      across = {-2.0, 1.0, 1.0};
+    } else if (k == 2) {  // the general formula gives a = 0, b = −1 up to rounding
+      across = {-1.0, 0.0, 1.0, 0.0};
+    } else {
+      const double theta = kPi / k;
+      const double c = std::cos(theta), s = std::sin(theta);
+      const double a = -c * (1.0 + c) / (s * (1.0 + 2.0 * c));
+      across[0] = -2.0 * a - (1.0 + c) / s;  // b; cot(θ/2) = (1 + cos θ)/sin θ
+      across[1] = across[k + 1] = a;
+      for (int j = 1; j < k; ++j) across[j + 1] = std::sin(j * theta);
+    }
+    sink.Add(v, 0.0, across[0]);
+    for (int j = 0; j <= k; ++j)
+      sink.Add(ring[j], j == 0 ? 1.0 : j == k ? -1.0 : 0.0, across[j + 1]);
+    sink.EndRow(kBoundaryTangentPattern + k);
+  }
+}
+
+// Sinks: rows of a SparseMatrix (zero weights dropped), or of a PointStencil.
+struct MatrixSink {
+  RowBuilder rows;
+  void Add(int column, double weight) {
+    if (weight != 0.0) rows.Add(column, weight);
+  }
+  void EndRow(int) { rows.EndRow(); }
+};
+
+struct TangentMatrixSink {
+  MatrixSink first, second;
+  void Add(int column, double w1, double w2) {
+    first.Add(column, w1);
+    second.Add(column, w2);
+  }
+  void EndRow(int pattern) {
+    first.EndRow(pattern);
+    second.EndRow(pattern);
+  }
+};
+
+struct StencilSink {
+  PointStencil stencil;
+  std::vector<int> columns;
+  std::vector<double> weights;
+  void Add(int column, double weight) {
+    columns.push_back(column);
+    weights.push_back(weight);
+  }
+  void Add(int column, double w1, double w2) {
+    columns.push_back(column);
+    weights.push_back(w1);
+    weights.push_back(w2);
+  }
+  void EndRow(int pattern) {
+    stencil.AddRow(columns, weights, pattern);
+    columns.clear();
+    weights.clear();
+  }
+};
+
+}  // namespace
+
+SparseMatrix LoopRefinementMatrix(const MeshTopology& topology) {
+  const int n = topology.vertex_count();
+  const int m = topology.edge_count();
+  MatrixSink sink{RowBuilder(n + m, n, static_cast<size_t>(n) * 7 + static_cast<size_t>(m) * 4)};
+  EmitRefinementRows(topology, sink);
+  return sink.rows.Build();
+}
+
+PointStencil LoopRefinementStencil(const MeshTopology& topology) {
+  StencilSink sink{PointStencil(1, topology.vertex_count()), {}, {}};
+  EmitRefinementRows(topology, sink);
+  return std::move(sink.stencil);
 }
 
 SparseMatrix UmbrellaLaplacian(const MeshTopology& topology) {
@@ -251,43 +341,16 @@ SparseMatrix LoopLimitPositionMatrix(const MeshTopology& topology) {
 
 std::array<SparseMatrix, 2> LoopLimitTangentMatrices(const MeshTopology& topology) {
   const int n = topology.vertex_count();
-  RowBuilder first(n, n, static_cast<size_t>(n) * 6), second(n, n, static_cast<size_t>(n) * 6);
-  for (int v = 0; v < n; ++v) {
-    CheckReferenced(topology, v);
-    const IndexRange ring = topology.Ring(v);
-    const int valence = ring.size();
-    if (!topology.IsBoundaryVertex(v)) {
-      for (int j = 0; j < valence; ++j) {
-        const double angle = 2.0 * kPi * j / valence;
-        first.Add(ring[j], std::cos(angle));
-        second.Add(ring[j], std::sin(angle));
-      }
-    } else {
-      const int k = valence - 1;  // faces around the boundary vertex
-      first.Add(ring.front(), 1.0);
-      first.Add(ring.back(), -1.0);
-      if (k == 1) {
-        second.Add(ring[0], 1.0);
-        second.Add(ring[1], 1.0);
-        second.Add(v, -2.0);
-      } else if (k == 2) {  // the general formula gives a = 0, b = −1 up to rounding
-        second.Add(ring[1], 1.0);
-        second.Add(v, -1.0);
-      } else {
-        const double theta = kPi / k;
-        const double c = std::cos(theta), s = std::sin(theta);
-        const double a = -c * (1.0 + c) / (s * (1.0 + 2.0 * c));
-        const double b = -2.0 * a - (1.0 + c) / s;  // cot(θ/2) = (1 + cos θ)/sin θ
-        second.Add(v, b);
-        second.Add(ring.front(), a);
-        second.Add(ring.back(), a);
-        for (int j = 1; j < k; ++j) second.Add(ring[j], std::sin(j * theta));
-      }
-    }
-    first.EndRow();
-    second.EndRow();
-  }
-  return {first.Build(), second.Build()};
+  TangentMatrixSink sink{{RowBuilder(n, n, static_cast<size_t>(n) * 6)},
+                         {RowBuilder(n, n, static_cast<size_t>(n) * 6)}};
+  EmitTangentRows(topology, sink);
+  return {sink.first.rows.Build(), sink.second.rows.Build()};
+}
+
+PointStencil LoopLimitTangentStencil(const MeshTopology& topology) {
+  StencilSink sink{PointStencil(2, topology.vertex_count()), {}, {}};
+  EmitTangentRows(topology, sink);
+  return std::move(sink.stencil);
 }
 
 }  // namespace subflow::geometry

@@ -13,6 +13,7 @@
 #include <Eigen/Sparse>
 
 #include "geometry/mesh_topology.h"
+#include "geometry/point_stencil.h"
 #include "geometry/triangle_mesh.h"
 
 namespace subflow::geometry {
@@ -86,8 +87,11 @@ SparseMatrix LoopLimitPositionMatrix(const MeshTopology& topology);
 // The scale of T1, T2 is arbitrary; only their directions carry meaning.
 std::array<SparseMatrix, 2> LoopLimitTangentMatrices(const MeshTopology& topology);
 
-// T1 and T2 interleaved, 2#V × #V: row 2v is row v of T1, row 2v + 1 row v of T2, so one
-// pass of MultiplyPoints gives both tangents of every vertex (local frames, synthesis).
-SparseMatrix InterleaveRows(const SparseMatrix& first, const SparseMatrix& second);
+// The same operators in the compact hot-path form (point_stencil.h): C with one channel;
+// [T1, T2] with two channels, entries in ring order (boundary vertices: v, r_0 … r_k).
+// In the tangent stencil, interior vertices of valence K have pattern key K (so key 6 =
+// regular vertices, weights cos/sin(2πj/6)).
+PointStencil LoopRefinementStencil(const MeshTopology& topology);
+PointStencil LoopLimitTangentStencil(const MeshTopology& topology);
 
 }  // namespace subflow::geometry

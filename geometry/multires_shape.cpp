@@ -57,7 +57,8 @@ MultiresShape MultiresShape::Analyze(const LoopHierarchy& hierarchy,
   Positions fine = finest_control_points;
   for (int level = n; level >= 1; --level) {
     Positions coarse = MultiplyPoints(hierarchy.Coarsening(level), fine);
-    const Positions predicted = MultiplyPoints(hierarchy.Refinement(level - 1), coarse);
+    Positions predicted;  // as synthesis computes it (same stencil, same rounding)
+    hierarchy.RefinementStencil(level - 1).Apply(coarse, &predicted);
     const LocalFrames frames = ComputeLocalFrames(hierarchy, level, predicted);
     shape.details_[level - 1] = frames.ToLocal(fine - predicted);
     fine = std::move(coarse);
@@ -74,19 +75,17 @@ Positions MultiresShape::Synthesize(const LoopHierarchy& hierarchy, int level,
     frames->clear();
     frames->resize(level);
   }
-  Positions c = base_, next;
+  Positions c = base_, predicted;
   for (int i = 1; i <= level; ++i) {
-    MultiplyPoints(hierarchy.Refinement(i - 1), c, &next);  // the predicted points
-    if (i <= detail_levels()) {
-      if (frames) {
-        LocalFrames level_frames = ComputeLocalFrames(hierarchy, i, next);
-        next += level_frames.ToWorld(Detail(i));
-        (*frames)[i - 1] = std::move(level_frames);
-      } else {
-        AddDetailsInLocalFrames(hierarchy, i, Detail(i), &next);
-      }
+    hierarchy.RefinementStencil(i - 1).Apply(c, &predicted);
+    if (i > detail_levels()) {
+      c.swap(predicted);
+    } else if (frames) {
+      (*frames)[i - 1] = ComputeLocalFrames(hierarchy, i, predicted);
+      c = predicted + (*frames)[i - 1].ToWorld(Detail(i));
+    } else {
+      AddDetailsInLocalFrames(hierarchy, i, predicted, Detail(i), &c);
     }
-    c.swap(next);
   }
   return c;
 }
@@ -99,8 +98,13 @@ std::vector<Positions> MultiresShape::SynthesizeLevels(const LoopHierarchy& hier
   levels.reserve(level + 1);
   levels.push_back(base_);
   for (int i = 1; i <= level; ++i) {
-    Positions predicted = MultiplyPoints(hierarchy.Refinement(i - 1), levels.back());
-    if (i <= detail_levels()) AddDetailsInLocalFrames(hierarchy, i, Detail(i), &predicted);
+    Positions predicted;
+    hierarchy.RefinementStencil(i - 1).Apply(levels.back(), &predicted);
+    if (i <= detail_levels()) {
+      Positions c;
+      AddDetailsInLocalFrames(hierarchy, i, predicted, Detail(i), &c);
+      predicted.swap(c);
+    }
     levels.push_back(std::move(predicted));
   }
   return levels;

@@ -3,7 +3,9 @@
 //
 // Two faces intersect when their triangles share a point that is not a vertex or an edge
 // common to both faces: neighbours meeting along their shared edge or at their shared
-// vertex do not intersect; coincident (duplicated) vertices with different indices do.
+// vertex do not intersect. The two tests differ on coincident vertices with different
+// indices: CGAL reports faces touching there, TetGen merges such vertices first and does
+// not; a mesh with coincident vertices can therefore make them disagree.
 #pragma once
 
 #include <string>

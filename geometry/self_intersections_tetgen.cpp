@@ -40,22 +40,28 @@ SelfIntersectionResult FindSelfIntersectionsTetgen(const TriangleMesh& mesh) {
   }
 
   // tetgenio owns and frees these arrays (delete[]), so they are allocated with new[].
-  // One extra point, on no face, off every axis-aligned plane of the mesh: TetGen's
-  // predicates assert (abort) when the bounding box is flat along an axis, as it is for
-  // a planar patch. A point on no face cannot change which faces intersect.
-  tetgenio in, out;
-  in.firstnumber = 0;
-  in.numberofpoints = n + 1;
-  in.pointlist = new REAL[3 * static_cast<size_t>(n + 1)];
-  for (int v = 0; v < n; ++v)
-    for (int axis = 0; axis < 3; ++axis) in.pointlist[3 * v + axis] = mesh.V(v, axis);
+  // TetGen's predicates assert (abort) when the bounding box is flat along an axis, as
+  // it is for a planar patch; then one extra point, on no face, lifts the box off that
+  // plane (a point on no face cannot change which faces intersect). Only then: a bigger
+  // box makes TetGen's bisection of the faces much less effective.
   Eigen::RowVector3d low = Eigen::RowVector3d::Zero(), high = Eigen::RowVector3d::Zero();
   if (n > 0) {
     low = mesh.V.colwise().minCoeff();
     high = mesh.V.colwise().maxCoeff();
   }
-  const double extent = (high - low).maxCoeff() > 0.0 ? (high - low).maxCoeff() : 1.0;
-  for (int axis = 0; axis < 3; ++axis) in.pointlist[3 * n + axis] = high(axis) + extent;
+  const Eigen::RowVector3d extent = high - low;
+  const bool flat = !(extent.minCoeff() > 0.0);
+  tetgenio in, out;
+  in.firstnumber = 0;
+  in.numberofpoints = n + (flat ? 1 : 0);
+  in.pointlist = new REAL[3 * static_cast<size_t>(in.numberofpoints)];
+  for (int v = 0; v < n; ++v)
+    for (int axis = 0; axis < 3; ++axis) in.pointlist[3 * v + axis] = mesh.V(v, axis);
+  if (flat) {
+    const double lift = extent.maxCoeff() > 0.0 ? extent.maxCoeff() : 1.0;
+    for (int axis = 0; axis < 3; ++axis)
+      in.pointlist[3 * n + axis] = extent(axis) > 0.0 ? 0.5 * (low(axis) + high(axis)) : low(axis) + lift;
+  }
   in.numberoffacets = static_cast<int>(input_faces.size());
   in.facetlist = new tetgenio::facet[input_faces.size()];
   for (size_t i = 0; i < input_faces.size(); ++i) {
@@ -83,7 +89,7 @@ SelfIntersectionResult FindSelfIntersectionsTetgen(const TriangleMesh& mesh) {
   // With -d TetGen outputs its nodes and the intersecting faces only; map them back to
   // our faces through the (sorted) vertex triple.
   std::vector<int> to_input_vertex(out.numberofpoints, -1);
-  if (out.numberofpoints == n + 1) {
+  if (out.numberofpoints == in.numberofpoints) {
     for (int v = 0; v < n; ++v) to_input_vertex[v] = v;
   } else if (out.numberofpoints > 0) {  // TetGen renumbered: match coordinates exactly
     std::map<std::array<double, 3>, int> by_position;

@@ -191,36 +191,40 @@ TriangleMesh SimplifyMesh(const TriangleMesh& mesh, const SimplifyOptions& optio
 
   SimplifySummary stats;
   stats.input_face_count = mesh.face_count();
-  SurfaceMesh result = ToSurfaceMesh(mesh);
-  if (mesh.face_count() > options.target_face_count) {
-    double target = options.target_face_count;
-    for (;;) {
-      ++stats.attempts;
-      SurfaceMesh attempt = stats.attempts == 1 ? result : ToSurfaceMesh(mesh);
-      GarlandHeckbert garland_heckbert(attempt);
-      const FaceCountStop stop{&attempt, static_cast<std::size_t>(std::lround(target))};
-      SMS::edge_collapse(attempt, stop,
-                         CGAL::parameters::get_cost(garland_heckbert.get_cost())
-                             .get_placement(garland_heckbert.get_placement())
-                             .filter(ShapeAndValenceFilter(options)));
-      attempt.collect_garbage();
-      for (int round = 0; round < options.flip_rounds; ++round) {
-        const int flips = FlipTowardsRegularValence(options, &attempt);
-        stats.flips += flips;
-        if (flips == 0) break;
-      }
-      if (!options.check_self_intersections || !PMP::does_self_intersect(attempt)) {
-        result = std::move(attempt);
-        break;
-      }
-      if (stats.attempts >= options.max_attempts)
-        ThrowError(source, "simplification",
-                   "every attempt (" + std::to_string(stats.attempts) +
-                       ", last target " + std::to_string(std::lround(target)) +
-                       " faces) gave a self-intersecting mesh; raise target_face_count");
-      target *= options.retry_growth;
-      stats.flips = 0;
+  if (mesh.face_count() <= options.target_face_count) {
+    stats.face_count = stats.input_face_count;
+    stats.vertex_count = mesh.vertex_count();
+    for (int v = 0; v < mesh.vertex_count(); ++v) ++stats.valence_histogram[topology.Valence(v)];
+    stats.seconds = SecondsSince(start);
+    if (summary != nullptr) *summary = stats;
+    return mesh;
+  }
+  const SurfaceMesh input = ToSurfaceMesh(mesh);
+  SurfaceMesh result;
+  double target = options.target_face_count;
+  for (;;) {
+    ++stats.attempts;
+    result = input;
+    GarlandHeckbert garland_heckbert(result);
+    const FaceCountStop stop{&result, static_cast<std::size_t>(std::lround(target))};
+    SMS::edge_collapse(result, stop,
+                       CGAL::parameters::get_cost(garland_heckbert.get_cost())
+                           .get_placement(garland_heckbert.get_placement())
+                           .filter(ShapeAndValenceFilter(options)));
+    result.collect_garbage();
+    stats.flips = 0;
+    for (int round = 0; round < options.flip_rounds; ++round) {
+      const int flips = FlipTowardsRegularValence(options, &result);
+      stats.flips += flips;
+      if (flips == 0) break;
     }
+    if (!options.check_self_intersections || !PMP::does_self_intersect(result)) break;
+    if (stats.attempts >= options.max_attempts)
+      ThrowError(source, "simplification",
+                 "every attempt (" + std::to_string(stats.attempts) + ", last target " +
+                     std::to_string(std::lround(target)) +
+                     " faces) gave a self-intersecting mesh; raise target_face_count");
+    target *= options.retry_growth;
   }
   TriangleMesh simplified = FromSurfaceMesh(std::move(result));
   const MeshTopology simplified_topology(simplified.F, simplified.vertex_count(),

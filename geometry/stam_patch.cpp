@@ -88,7 +88,7 @@ void StamPatchWeights(const StamPatch& patch, double u, double v, Eigen::RowVect
   } else if (vs >= 0.5) {
     k = 1, u1 = 2 * us, v1 = 2 * vs - 1, jacobian.setIdentity();
   } else {
-    k = 2, u1 = 1 - 2 * us, v1 = 2 * us + 2 * vs - 1;
+    k = 2, u1 = 2 * us + 2 * vs - 1, v1 = 1 - 2 * us;
     jacobian << 1, 1, -1, 0;
   }
   std::array<double, 12> b, b_du, b_dv;

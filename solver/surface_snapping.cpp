@@ -67,7 +67,7 @@ Positions SnapToSurface(const geometry::LoopHierarchy& hierarchy, int level,
       report->rms_distance_before = Rms(distance);
       report->vertices_without_hit = misses;
     }
-    snapped += normals.array().colwise() * distance.array();
+    snapped += (normals.array().colwise() * distance.array()).matrix();
   }
   Positions result = control + options.weight * (snapped - control);
   if (report) {

@@ -36,52 +36,101 @@ struct CarvingCamera {
   cv::Mat integral;  // CV_64F (h + 1) × (w + 1) summed-area table of the evidence
 };
 
+// Sum of the evidence over pixels [x0, x1] × [y0, y1] (inclusive) from a summed-area table.
+inline double BoxSum(const double* sums, size_t stride, int x0, int x1, int y0, int y1) {
+  return sums[(y1 + 1) * stride + x1 + 1] - sums[y0 * stride + x1 + 1] - sums[(y1 + 1) * stride + x0] +
+         sums[y0 * stride + x0];
+}
+
 // Counts, for every voxel, the cameras that see it and support it (hits) or not (misses).
 // Voxels with more than max_misses misses are skipped by later cameras (already carved).
+// Tasks are slabs of 4 z-slices, visited in blocks of kBlock × kBlock voxels.
+//
+// Speed-up, exact: for a pinhole camera, a block of up to kBlock × kBlock voxels of the
+// slab is first tested as a whole. The footprint of every voxel in it lies in the block's
+// footprint (the bounding box of the block's 8 projected corners: perspective maps the
+// box to the convex hull of its corners), so when the block's footprint is inside the
+// image and its pixels — grown by one pixel to cover the nearest-pixel rule — have
+// evidence all 0 (mean 0) or all 1 (mean = 1), every voxel is a miss or a hit without
+// looking at it. Only blocks straddling the silhouette's contour are visited voxel by
+// voxel, so the cost follows the object's surface, not its volume.
 void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingCamera>& used,
                   const ScalarVolume& grid, double threshold, int max_misses,
                   std::vector<uint16_t>* hits, std::vector<uint16_t>* misses) {
-  const size_t row = grid.nx + 1, plane = row * (grid.ny + 1);
-  tbb::parallel_for(tbb::blocked_range<int>(0, grid.nz, 4), [&](const tbb::blocked_range<int>& range) {
-    std::vector<float> us, vs;
+  constexpr int kSlab = 4, kBlock = 8;
+  tbb::parallel_for(tbb::blocked_range<int>(0, grid.nz, kSlab), [&](const tbb::blocked_range<int>& range) {
+    const int k0 = range.begin(), k1 = range.end();
+    constexpr size_t kCorners = (kBlock + 1) * (kBlock + 1) * (kSlab + 1);
+    float us[kCorners], vs[kCorners];
     for (const CarvingCamera& carving_camera : used) {
       const Camera& camera = cameras[carving_camera.index];
       const int width = camera.width(), height = camera.height();
       const double* sums = carving_camera.integral.ptr<double>();
       const size_t stride = width + 1;
+      const bool pinhole = !camera.HasDistortion();
       const VoxelCornerProjector projector(camera, grid);
-      us.resize(plane * (range.size() + 1));
-      vs.resize(us.size());
-      for (int k = range.begin(); k <= range.end(); ++k)
-        projector.ProjectPlane(k, &us[(k - range.begin()) * plane], &vs[(k - range.begin()) * plane]);
-      for (int k = range.begin(); k < range.end(); ++k)
-        for (int j = 0; j < grid.ny; ++j)
-          for (int i = 0; i < grid.nx; ++i) {
-            const size_t voxel = grid.Index(i, j, k);
-            if ((*misses)[voxel] > max_misses) continue;
-            const size_t c0 = (k - range.begin()) * plane + j * row + i;
-            const size_t corners[8] = {c0,         c0 + 1,         c0 + row,         c0 + row + 1,
-                                       c0 + plane, c0 + plane + 1, c0 + plane + row, c0 + plane + row + 1};
-            float x_min = us[c0], x_max = us[c0], y_min = vs[c0], y_max = vs[c0];
-            for (size_t c : corners) {
-              x_min = std::min(x_min, us[c]);
-              x_max = std::max(x_max, us[c]);
-              y_min = std::min(y_min, vs[c]);
-              y_max = std::max(y_max, vs[c]);
+      // Bounding box of the projections of 8 corners (indices into us / vs); false when
+      // it is not inside the image or a corner is behind the camera (kInvalidPixel).
+      auto footprint = [&](const size_t* corners, float* x_min, float* x_max, float* y_min, float* y_max) {
+        *x_min = *x_max = us[corners[0]];
+        *y_min = *y_max = vs[corners[0]];
+        for (int c = 1; c < 8; ++c) {
+          *x_min = std::min(*x_min, us[corners[c]]);
+          *x_max = std::max(*x_max, us[corners[c]]);
+          *y_min = std::min(*y_min, vs[corners[c]]);
+          *y_max = std::max(*y_max, vs[corners[c]]);
+        }
+        return *x_min >= -0.5f && *y_min >= -0.5f && *x_max < width - 0.5f && *y_max < height - 0.5f;
+      };
+      for (int j_begin = 0; j_begin < grid.ny; j_begin += kBlock)
+        for (int i_begin = 0; i_begin < grid.nx; i_begin += kBlock) {
+          const int j_end = std::min(j_begin + kBlock, grid.ny), i_end = std::min(i_begin + kBlock, grid.nx);
+          const size_t row = i_end - i_begin + 1, plane = row * (j_end - j_begin + 1);
+          if (pinhole) {
+            // The block's 8 outer corners, stored where the block's full corner grid would put them.
+            const size_t di = row - 1, dj = plane - row, dk = (k1 - k0) * plane;
+            const size_t corners[8] = {0, di, dj, di + dj, dk, dk + di, dk + dj, dk + di + dj};
+            for (size_t c : corners)
+              projector.ProjectCorner(i_begin + (c % row), j_begin + (c % plane) / row, k0 + c / plane, &us[c], &vs[c]);
+            float x_min, x_max, y_min, y_max;
+            if (footprint(corners, &x_min, &x_max, &y_min, &y_max)) {
+              const int x0 = std::max(0, static_cast<int>(std::floor(x_min)));
+              const int x1 = std::min(width - 1, static_cast<int>(std::ceil(x_max)));
+              const int y0 = std::max(0, static_cast<int>(std::floor(y_min)));
+              const int y1 = std::min(height - 1, static_cast<int>(std::ceil(y_max)));
+              const double sum = BoxSum(sums, stride, x0, x1, y0, y1);
+              const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
+              if (sum <= 0 || sum >= area) {
+                std::vector<uint16_t>& counts = sum <= 0 ? *misses : *hits;
+                for (int k = k0; k < k1; ++k)
+                  for (int j = j_begin; j < j_end; ++j)
+                    for (size_t v = grid.Index(i_begin, j, k), end = v + (i_end - i_begin); v < end; ++v)
+                      ++counts[v];
+                continue;
+              }
             }
-            if (!(x_min >= -0.5f && y_min >= -0.5f && x_max < width - 0.5f && y_max < height - 0.5f))
-              continue;  // not seen: partly outside the image or behind the camera
-            // Pixels whose centres lie in the footprint; the nearest one if none does.
-            int x0 = static_cast<int>(std::ceil(x_min)), x1 = static_cast<int>(std::floor(x_max));
-            int y0 = static_cast<int>(std::ceil(y_min)), y1 = static_cast<int>(std::floor(y_max));
-            if (x0 > x1) x0 = x1 = std::clamp(static_cast<int>(std::lround(0.5f * (x_min + x_max))), 0, width - 1);
-            if (y0 > y1) y0 = y1 = std::clamp(static_cast<int>(std::lround(0.5f * (y_min + y_max))), 0, height - 1);
-            const double sum = sums[(y1 + 1) * stride + x1 + 1] - sums[y0 * stride + x1 + 1] -
-                               sums[(y1 + 1) * stride + x0] + sums[y0 * stride + x0];
-            const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
-            if (sum >= threshold * area) ++(*hits)[voxel];
-            else ++(*misses)[voxel];
           }
+          projector.ProjectCorners(i_begin, i_end, j_begin, j_end, k0, k1, us, vs);
+          for (int k = k0; k < k1; ++k)
+            for (int j = j_begin; j < j_end; ++j)
+              for (int i = i_begin; i < i_end; ++i) {
+                const size_t voxel = grid.Index(i, j, k);
+                if ((*misses)[voxel] > max_misses) continue;
+                const size_t c0 = (k - k0) * plane + (j - j_begin) * row + (i - i_begin);
+                const size_t corners[8] = {c0,         c0 + 1,         c0 + row,         c0 + row + 1,
+                                           c0 + plane, c0 + plane + 1, c0 + plane + row, c0 + plane + row + 1};
+                float x_min, x_max, y_min, y_max;
+                if (!footprint(corners, &x_min, &x_max, &y_min, &y_max)) continue;
+                // Pixels whose centres lie in the footprint; per axis the nearest when none does.
+                int x0 = static_cast<int>(std::ceil(x_min)), x1 = static_cast<int>(std::floor(x_max));
+                int y0 = static_cast<int>(std::ceil(y_min)), y1 = static_cast<int>(std::floor(y_max));
+                if (x0 > x1) x0 = x1 = std::clamp(static_cast<int>(std::lround(0.5f * (x_min + x_max))), 0, width - 1);
+                if (y0 > y1) y0 = y1 = std::clamp(static_cast<int>(std::lround(0.5f * (y_min + y_max))), 0, height - 1);
+                const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
+                if (BoxSum(sums, stride, x0, x1, y0, y1) >= threshold * area) ++(*hits)[voxel];
+                else ++(*misses)[voxel];
+              }
+        }
     }
   });
 }

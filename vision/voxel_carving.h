@@ -15,8 +15,9 @@
 //              polynomial cannot fold back) and the footprint lies inside the image
 //              [−½, w − ½) × [−½, h − ½) (pixel (0, 0) = centre of the top-left pixel);
 //   evidence   e_k(V) = mean of the camera's evidence image over the pixels whose centres
-//              lie in the footprint (summed-area table, cv::integral, O(1) per voxel; the
-//              pixel nearest the footprint's centre when none does);
+//              lie in the footprint (summed-area table, cv::integral, O(1) per voxel;
+//              along an axis where the footprint contains no pixel centre, the pixel
+//              row / column nearest its centre);
 //   hit / miss e_k(V) ≥ evidence_threshold / below it.
 // V is occupied ⇔ hits(V) ≥ min_cameras and misses(V) ≤ max_misses. So a voxel is carved
 // only by the cameras that see it (a partial rig works), and a voxel seen by fewer than

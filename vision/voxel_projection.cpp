@@ -96,29 +96,33 @@ bool VoxelCornerProjector::ProjectCorner(int i, int j, int k, float* u, float* v
   return true;
 }
 
-void VoxelCornerProjector::ProjectPlane(int k, float* us, float* vs) const {
-  const int row = grid_.nx + 1;
+void VoxelCornerProjector::ProjectCorners(int i0, int i1, int j0, int j1, int k0, int k1, float* us,
+                                          float* vs) const {
+  const int row = i1 - i0 + 1;
+  size_t index = 0;
   if (distorted_) {
-    for (int j = 0; j <= grid_.ny; ++j)
-      for (int i = 0; i <= grid_.nx; ++i) ProjectCorner(i, j, k, &us[j * row + i], &vs[j * row + i]);
+    for (int k = k0; k <= k1; ++k)
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i, ++index) ProjectCorner(i, j, k, &us[index], &vs[index]);
     return;
   }
   const float dx = static_cast<float>(dh_i_.x()), dy = static_cast<float>(dh_i_.y()),
               dz = static_cast<float>(dh_i_.z());
-  for (int j = 0; j <= grid_.ny; ++j) {
-    const Eigen::Vector3d base = h0_ + j * dh_j_ + k * dh_k_;
-    const float bx = static_cast<float>(base.x()), by = static_cast<float>(base.y()),
-                bz = static_cast<float>(base.z());
-    float* u = us + j * row;
-    float* v = vs + j * row;
-    for (int i = 0; i < row; ++i) {  // vectorizable: no branches
-      const float hx = bx + i * dx, hy = by + i * dy, hz = bz + i * dz;
-      const bool in_front = hz > 0.0f;
-      const float inverse = 1.0f / (in_front ? hz : 1.0f);
-      u[i] = in_front ? hx * inverse : kInvalidPixel;
-      v[i] = in_front ? hy * inverse : kInvalidPixel;
+  for (int k = k0; k <= k1; ++k)
+    for (int j = j0; j <= j1; ++j, index += row) {
+      const Eigen::Vector3d base = h0_ + i0 * dh_i_ + j * dh_j_ + k * dh_k_;
+      const float bx = static_cast<float>(base.x()), by = static_cast<float>(base.y()),
+                  bz = static_cast<float>(base.z());
+      float* u = us + index;
+      float* v = vs + index;
+      for (int i = 0; i < row; ++i) {  // vectorizable: no branches
+        const float hx = bx + i * dx, hy = by + i * dy, hz = bz + i * dz;
+        const bool in_front = hz > 0.0f;
+        const float inverse = 1.0f / (in_front ? hz : 1.0f);
+        u[i] = in_front ? hx * inverse : kInvalidPixel;
+        v[i] = in_front ? hy * inverse : kInvalidPixel;
+      }
     }
-  }
 }
 
 bool ProjectsIntoImage(const Camera& camera, const Eigen::Vector3d& X) {

@@ -33,11 +33,12 @@ class VoxelCornerProjector {
   Eigen::Vector3d Corner(int i, int j, int k) const;
   // Pixel of corner (i, j, k); false (and kInvalidPixel) when it cannot be projected.
   bool ProjectCorner(int i, int j, int k, float* u, float* v) const;
-  // Pixels of the (nx + 1)(ny + 1) corners of plane k, x fastest. A pinhole camera's
-  // h = K (R X + t) is affine in (i, j, k), so a corner costs two multiply-adds per
+  // Pixels of the corners [i0, i1] × [j0, j1] × [k0, k1] (inclusive), x fastest, then y,
+  // then z: (i1 − i0 + 1)(j1 − j0 + 1)(k1 − k0 + 1) values each. A pinhole camera's
+  // h = K (R X + t) is affine in (i, j, k), so a corner costs a multiply-add per
   // coordinate and one division (float, error ~1e-5 px); a distorted camera goes through
   // Camera::Project.
-  void ProjectPlane(int k, float* us, float* vs) const;
+  void ProjectCorners(int i0, int i1, int j0, int j1, int k0, int k1, float* us, float* vs) const;
 
  private:
   const Camera& camera_;

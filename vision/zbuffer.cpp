@@ -27,26 +27,26 @@ bool ScreenLess(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
 }
 
-// The edge function of a→b, E(p) = (b − a) × (p − a), evaluated from the canonical
-// (lexicographically smaller) end so that the edge b→a of the neighbouring triangle
-// gives exactly −E at every pixel: a shared edge's pixels are claimed exactly once.
+// The edge function of a→b, E(p) = (b − a) × (p − a), written E = A x + B y + C with
+// A, B, C computed from the canonical (lexicographically smaller) end: the edge b→a of
+// the neighbouring triangle gets exactly −A, −B, −C, and since rounding is symmetric
+// it gets exactly −E at every pixel. So a shared edge's pixel centres are claimed once.
 struct Edge {
-  Eigen::Vector2d origin, direction;
-  double sign = 1.0;
+  double A = 0.0, B = 0.0, C = 0.0;
   bool owns_ties = false;  // a centre with E = 0 is inside (one of the two directions)
 
   Edge(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     const bool forward = ScreenLess(a, b);
-    origin = forward ? a : b;
-    direction = forward ? Eigen::Vector2d(b - a) : Eigen::Vector2d(a - b);
-    sign = forward ? 1.0 : -1.0;
+    const Eigen::Vector2d& origin = forward ? a : b;
+    const Eigen::Vector2d direction = forward ? Eigen::Vector2d(b - a) : Eigen::Vector2d(a - b);
+    const double sign = forward ? 1.0 : -1.0;
+    A = -sign * direction.y();
+    B = sign * direction.x();
+    C = sign * (direction.y() * origin.x() - direction.x() * origin.y());
     const Eigen::Vector2d d = b - a;
     owns_ties = d.y() > 0.0 || (d.y() == 0.0 && d.x() < 0.0);
   }
-  double operator()(double x, double y) const {
-    return sign * (direction.x() * (y - origin.y()) - direction.y() * (x - origin.x()));
-  }
-  bool Inside(double e) const { return e > 0.0 || (e == 0.0 && owns_ties); }
+  bool Inside(double e) const { return owns_ties ? !(e < 0.0) : e > 0.0; }
 };
 
 }  // namespace
@@ -80,41 +80,42 @@ class TriangleRasterizer {
     const int y1 = static_cast<int>(std::floor(std::min(max_y, height - 1.0)));
     if (x0 > x1 || y0 > y1) return;
 
-    // Edge k is opposite vertex k: its function is vertex k's screen barycentric × 2 area.
+    // Edge k is opposite vertex k: E_k = 2 area · (screen barycentric of vertex k).
     const Edge edges[3] = {Edge(b.pixel, c.pixel), Edge(c.pixel, a.pixel), Edge(a.pixel, b.pixel)};
+    const double twice_area = std::abs(area);
     const bool identity_weights = a.weights == Eigen::Vector3d::UnitX() &&
                                   b.weights == Eigen::Vector3d::UnitY() &&
                                   c.weights == Eigen::Vector3d::UnitZ();
     for (int y = y0; y <= y1; ++y) {
+      const double row[3] = {edges[0].B * y + edges[0].C, edges[1].B * y + edges[1].C,
+                             edges[2].B * y + edges[2].C};
       for (int x = x0; x <= x1; ++x) {
-        double e[3];
-        bool inside = true;
-        for (int k = 0; k < 3 && inside; ++k) {
-          e[k] = edges[k](x, y);
-          inside = edges[k].Inside(e[k]);
-        }
-        if (!inside) continue;
-        const double sum = e[0] + e[1] + e[2];
-        if (!(sum > 0.0)) continue;
-        // Perspective-correct weights: screen barycentrics λ_k divided by depth z_k.
-        double w[3], s = 0.0;
-        for (int k = 0; k < 3; ++k) {
-          w[k] = (e[k] / sum) * v[k]->inverse_depth;
-          s += w[k];
-        }
-        const double depth = 1.0 / s;
+        const double e0 = edges[0].A * x + row[0];
+        if (!edges[0].Inside(e0)) continue;
+        const double e1 = edges[1].A * x + row[1];
+        if (!edges[1].Inside(e1)) continue;
+        const double e2 = edges[2].A * x + row[2];
+        if (!edges[2].Inside(e2)) continue;
+        // Perspective-correct: 1/z and the 3D barycentrics are the screen barycentrics
+        // λ_k = E_k / 2A weighted by 1/z_k: 1/z = Σ λ_k/z_k, b_k = (λ_k/z_k) · z.
+        const double w0 = e0 * v[0]->inverse_depth, w1 = e1 * v[1]->inverse_depth,
+                     w2 = e2 * v[2]->inverse_depth;
+        const double s = w0 + w1 + w2;
+        if (!(s > 0.0)) continue;
+        const double depth = twice_area / s;
         const std::size_t index = zbuffer_.Index(x, y);
         if (!(depth < zbuffer_.depth_[index])) continue;
         zbuffer_.depth_[index] = static_cast<float>(depth);
         zbuffer_.face_[index] = face;
-        Eigen::Vector3d weights;
+        const double inverse_s = 1.0 / s;
         if (identity_weights) {
-          weights = Eigen::Vector3d(w[0], w[1], w[2]) / s;
+          zbuffer_.barycentric_[2 * index] = static_cast<float>(w1 * inverse_s);
+          zbuffer_.barycentric_[2 * index + 1] = static_cast<float>(w2 * inverse_s);
         } else {
-          weights = (w[0] * a.weights + w[1] * b.weights + w[2] * c.weights) / s;
+          const Eigen::Vector3d weights = (w0 * a.weights + w1 * b.weights + w2 * c.weights) * inverse_s;
+          zbuffer_.barycentric_[2 * index] = static_cast<float>(weights.y());
+          zbuffer_.barycentric_[2 * index + 1] = static_cast<float>(weights.z());
         }
-        zbuffer_.barycentric_[2 * index] = static_cast<float>(weights.y());
-        zbuffer_.barycentric_[2 * index + 1] = static_cast<float>(weights.z());
       }
     }
   }

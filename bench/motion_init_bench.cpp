@@ -1,0 +1,181 @@
+// Motion initialization on the blob dataset (10 cameras, 320×240, 24 frames): seconds per
+// frame step, with the stages timed alone as references (visibility, constraint
+// building), and the scene-flow end-point error against the ground truth for the motion
+// estimate, zero motion and per-frame snapping alone.
+//
+// Shape: a Loop hierarchy on icosphere(2) (162 base vertices, 2 levels → 2562 finest
+// control points) whose finest control points are snapped onto the ground-truth mesh of
+// the reference frame (an oracle for shape initialization). "Per-frame snapping alone"
+// snaps the same template onto every frame's ground truth independently (the best a
+// normal-only, hull-like correspondence can do); "hull" runs use those per-frame fits as
+// the per-frame surfaces of the normal correction.
+// The sequence benchmarks run once (Iterations(1)); set SUBFLOW_BENCH_FRAMES to use fewer
+// frames.
+#include <cstdio>
+#include <cstdlib>
+
+#include <benchmark/benchmark.h>
+
+#include "geometry/closest_point.h"
+#include "geometry/icosphere.h"
+#include "geometry/loop_hierarchy.h"
+#include "geometry/mesh_io.h"
+#include "solver/motion_init.h"
+#include "solver/surface_snapping.h"
+#include "vision/dataset.h"
+#include "vision/evaluation.h"
+
+namespace {
+
+using namespace subflow;
+using geometry::Positions;
+
+constexpr int kLevels = 2;
+
+struct Blob {
+  vision::Dataset dataset{SUBFLOW_SHARED_DIR "/data/blob"};
+  geometry::TriangleMesh base = geometry::MakeIcosphere(2, 0.1);
+  geometry::LoopHierarchy hierarchy{base.F, base.vertex_count(), kLevels};
+  int frames = 0;
+  std::vector<geometry::TriangleMesh> truth;
+  std::vector<Positions> fits;  // per frame: the template snapped onto the ground truth
+
+  Blob() {
+    frames = dataset.frame_count();
+    if (const char* env = std::getenv("SUBFLOW_BENCH_FRAMES")) frames = std::min(frames, std::atoi(env));
+    Positions sphere = hierarchy.Refine(base.V, 0, kLevels);
+    for (Eigen::Index i = 0; i < sphere.rows(); ++i) sphere.row(i) *= 0.1 / sphere.row(i).norm();
+    solver::SurfaceSnapOptions snap;
+    snap.iterations = 12;
+    for (int f = 0; f < frames; ++f) {
+      truth.push_back(geometry::ReadMesh(dataset.GroundTruthMeshPath(f)));
+      const geometry::ClosestPointTree tree(truth.back(), "ground truth");
+      fits.push_back(solver::SnapToSurface(hierarchy, kLevels, sphere, tree, snap));
+    }
+  }
+  std::vector<cv::Mat> Images(int frame) const {
+    std::vector<cv::Mat> images;
+    for (int k = 0; k < dataset.camera_count(); ++k) images.push_back(dataset.Gray(k, frame));
+    return images;
+  }
+};
+
+const Blob& GetBlob() {
+  static const Blob blob;
+  return blob;
+}
+
+void BM_MotionStep(benchmark::State& state) {
+  const Blob& blob = GetBlob();
+  const solver::MotionStepEstimator estimator(blob.hierarchy, blob.dataset.cameras(), blob.fits[0]);
+  const std::vector<cv::Mat> before = blob.Images(0), after = blob.Images(1);
+  solver::MotionStep step;
+  for (auto _ : state) step = estimator.Estimate(blob.fits[0], before, after);
+  state.counters["samples"] = step.report.samples;
+  state.counters["constraints"] = step.report.constraints;
+  state.counters["pruned"] = step.report.pruned;
+  state.counters["cg_iterations"] = step.report.cg_iterations;
+  state.counters["photometric_zero"] = step.report.photometric_rms_zero;
+  state.counters["photometric"] = step.report.photometric_rms;
+}
+BENCHMARK(BM_MotionStep)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
+
+// Reference: the visibility stage alone (tessellation, 10 z-buffers, per-sample tests).
+void BM_VisibilityReference(benchmark::State& state) {
+  const Blob& blob = GetBlob();
+  const solver::MotionStepEstimator estimator(blob.hierarchy, blob.dataset.cameras(), blob.fits[0]);
+  const solver::SurfaceSamples& samples = estimator.samples();
+  const Positions X = samples.SamplePositions(blob.fits[0]);
+  const Positions normals = samples.SampleNormals(blob.fits[0]);
+  for (auto _ : state) {
+    auto visibility = estimator.visibility().Compute(blob.dataset.cameras(), blob.fits[0], X, normals);
+    benchmark::DoNotOptimize(visibility.visible.data());
+  }
+}
+BENCHMARK(BM_VisibilityReference)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Reference: one pass of constraint building (smoothing 20 images, bilinear sampling).
+void BM_ConstraintsReference(benchmark::State& state) {
+  const Blob& blob = GetBlob();
+  const solver::MotionStepEstimator estimator(blob.hierarchy, blob.dataset.cameras(), blob.fits[0]);
+  const solver::SurfaceSamples& samples = estimator.samples();
+  const Positions X = samples.SamplePositions(blob.fits[0]);
+  const auto visibility = estimator.visibility().Compute(blob.dataset.cameras(), blob.fits[0], X,
+                                                         samples.SampleNormals(blob.fits[0]));
+  const std::vector<cv::Mat> before = blob.Images(0), after = blob.Images(1);
+  for (auto _ : state) {
+    std::vector<solver::SmoothedImage> sb, sa;
+    for (std::size_t k = 0; k < before.size(); ++k) {
+      sb.push_back(solver::SmoothImage(before[k], 1.0));
+      sa.push_back(solver::SmoothImage(after[k], 1.0));
+    }
+    auto constraints = solver::BuildStepConstraints(blob.dataset.cameras(), sb, sa, X, Positions(), visibility);
+    benchmark::DoNotOptimize(constraints.rhs.data());
+  }
+}
+BENCHMARK(BM_ConstraintsReference)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// End-point error of a per-frame sequence of finest control points, on the limit
+// tessellation (density 2), motion = vertex differences (or zero).
+vision::EvaluationReport Evaluate(const Blob& blob, const std::vector<Positions>& control,
+                                  bool zero_motion) {
+  const solver::VisibilityTester tessellator(blob.hierarchy, kLevels);
+  vision::EvaluationOptions options;
+  options.samples = 5000;
+  return vision::EvaluateSequence(
+      blob.frames, [&](int f) { return blob.truth[f]; },
+      [&](int f) {
+        vision::EvaluationFrame frame;
+        frame.mesh = tessellator.Tessellation(control[f]);
+        if (zero_motion) frame.motion = Positions::Zero(frame.mesh.vertex_count(), 3);
+        return frame;
+      },
+      options);
+}
+
+void Report(benchmark::State& state, const vision::EvaluationReport& report) {
+  state.counters["epe_mean_mm"] = 1e3 * report.overall.flow.epe_mean;
+  state.counters["epe_median_mm"] = 1e3 * report.overall.flow.epe_median;
+  state.counters["epe_relative"] = report.overall.flow.epe_relative;
+  state.counters["true_motion_mm"] = 1e3 * report.overall.flow.true_motion_mean;
+  state.counters["chamfer_mm"] = 1e3 * report.overall.surface.chamfer;
+}
+
+void BM_BlobZeroMotion(benchmark::State& state) {
+  const Blob& blob = GetBlob();
+  vision::EvaluationReport report;
+  for (auto _ : state) report = Evaluate(blob, blob.fits, true);
+  Report(state, report);
+}
+BENCHMARK(BM_BlobZeroMotion)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+void BM_BlobPerFrameSnapping(benchmark::State& state) {
+  const Blob& blob = GetBlob();
+  vision::EvaluationReport report;
+  for (auto _ : state) report = Evaluate(blob, blob.fits, false);
+  Report(state, report);
+}
+BENCHMARK(BM_BlobPerFrameSnapping)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+// state.range(0): hull weight in percent (0 = only the reference frame's fit is used).
+void BM_BlobMotionInit(benchmark::State& state) {
+  const Blob& blob = GetBlob();
+  solver::MotionInitOptions options;
+  options.hull_weight = state.range(0) / 100.0;
+  std::vector<Positions> initial =
+      options.hull_weight > 0.0 ? blob.fits : std::vector<Positions>{blob.fits[0]};
+  solver::MotionInitResult result;
+  for (auto _ : state)
+    result = solver::InitializeMotion(blob.dataset.cameras(), blob.frames,
+                                      [&](int k, int f) { return blob.dataset.Gray(k, f); },
+                                      blob.hierarchy, initial, 0, options);
+  double step_seconds = 0.0;
+  for (int f = 1; f < blob.frames; ++f) step_seconds += result.frames[f].step.seconds;
+  state.counters["seconds_per_step"] = step_seconds / std::max(1, blob.frames - 1);
+  Report(state, Evaluate(blob, result.control, false));
+}
+BENCHMARK(BM_BlobMotionInit)->Arg(0)->Arg(50)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,89 @@
+// ClosestPointTree against closed-form answers on an icosphere and a single triangle.
+#include "geometry/closest_point.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "geometry/error.h"
+#include "geometry/icosphere.h"
+
+namespace subflow::geometry {
+namespace {
+
+TEST(ClosestPoint, SingleTriangleGivesTheOrthogonalProjectionAndItsBarycentrics) {
+  TriangleMesh triangle;
+  triangle.V.resize(3, 3);
+  triangle.V << 0, 0, 0, 2, 0, 0, 0, 1, 0;
+  triangle.F.resize(1, 3);
+  triangle.F << 0, 1, 2;
+  const ClosestPointTree tree(triangle);
+  // Interior: straight down onto the plane z = 0; (u, v) = (x/2, y).
+  const SurfacePoint inside = tree.Closest(Eigen::Vector3d(0.5, 0.25, 0.7));
+  EXPECT_EQ(inside.face, 0);
+  EXPECT_NEAR((inside.point - Eigen::Vector3d(0.5, 0.25, 0.0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR(inside.distance, 0.7, 1e-15);
+  EXPECT_NEAR(inside.barycentric.x(), 0.25, 1e-15);
+  EXPECT_NEAR(inside.barycentric.y(), 0.25, 1e-15);
+  EXPECT_NEAR((FacePoint(triangle.V, triangle.F, 0, inside.barycentric) - inside.point).norm(), 0.0, 1e-15);
+  // Beyond a corner: the corner itself.
+  const SurfacePoint corner = tree.Closest(Eigen::Vector3d(3.0, -1.0, 0.0));
+  EXPECT_NEAR((corner.point - Eigen::Vector3d(2, 0, 0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR(corner.barycentric.x(), 1.0, 1e-15);
+  // Rays: hit from above, miss sideways, both directions on a line.
+  const RayHit down = tree.FirstHit(Eigen::Vector3d(0.2, 0.2, 1.0), Eigen::Vector3d(0, 0, -2));
+  ASSERT_TRUE(down.hit);
+  EXPECT_NEAR(down.t, 1.0, 1e-15);  // t is a distance: direction normalized
+  EXPECT_NEAR(down.barycentric.x(), 0.1, 1e-15);
+  EXPECT_FALSE(tree.FirstHit(Eigen::Vector3d(0.2, 0.2, 1.0), Eigen::Vector3d(0, 0, 1)).hit);
+  EXPECT_FALSE(tree.FirstHit(Eigen::Vector3d(0.2, 0.2, 1.0), Eigen::Vector3d(0, 0, -1), 0.5).hit);
+  const RayHit line = tree.NearestHitOnLine(Eigen::Vector3d(0.2, 0.2, 1.0), Eigen::Vector3d(0, 0, 1));
+  ASSERT_TRUE(line.hit);
+  EXPECT_NEAR(line.t, -1.0, 1e-15);
+}
+
+TEST(ClosestPoint, IcosphereQueriesAgreeWithTheSphere) {
+  // Icosphere of radius 1 with 4 levels: inscribed, sagitta ≤ 1.2e-3, so the distance
+  // to the mesh of a point at radius ρ is |ρ − 1| within 1.2e-3.
+  const TriangleMesh sphere = MakeIcosphere(4, 1.0);
+  const ClosestPointTree tree(sphere);
+  std::mt19937 generator(3);
+  std::normal_distribution<double> normal;
+  Positions queries(500, 3);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3d direction = Eigen::Vector3d(normal(generator), normal(generator), normal(generator)).normalized();
+    queries.row(i) = ((i % 2 ? 1.5 : 0.6) * direction).transpose();
+  }
+  const std::vector<SurfacePoint> closest = tree.ClosestPoints(queries);
+  const Eigen::VectorXd distances = tree.Distances(queries);
+  const std::vector<RayHit> hits = tree.NearestHitsOnLines(queries, queries);  // radial lines
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector3d q = queries.row(i);
+    const double expected = std::abs(q.norm() - 1.0);
+    EXPECT_NEAR(closest[i].distance, expected, 1.2e-3);
+    EXPECT_NEAR(distances[i], closest[i].distance, 1e-14);
+    const Eigen::Vector2d uv = closest[i].barycentric;
+    EXPECT_GE(std::min({uv.x(), uv.y(), 1.0 - uv.x() - uv.y()}), -1e-12);
+    EXPECT_NEAR((FacePoint(sphere.V, sphere.F, closest[i].face, uv) - closest[i].point).norm(), 0.0, 1e-14);
+    ASSERT_TRUE(hits[i].hit);
+    EXPECT_NEAR(std::abs(hits[i].t), expected, 1.2e-3);
+    EXPECT_EQ(hits[i].t < 0.0, q.norm() > 1.0);  // outside points snap back along −q
+    EXPECT_EQ(tree.IsInside(q), q.norm() < 1.0);
+    EXPECT_EQ(tree.SignedDistance(q) < 0.0, q.norm() < 1.0);
+  }
+  EXPECT_EQ(tree.Side(Eigen::Vector3d(5, 0, 0)), PointSide::kOutside);
+}
+
+TEST(ClosestPoint, DegenerateFacesAreSkippedAndBadIndicesRejected) {
+  TriangleMesh mesh = MakeIcosphere(1, 1.0);
+  mesh.F.conservativeResize(mesh.F.rows() + 1, 3);
+  mesh.F.row(mesh.F.rows() - 1) << 0, 0, 1;  // zero area
+  const ClosestPointTree tree(mesh);
+  EXPECT_LT(tree.Closest(mesh.V.row(0).transpose() * 2.0).face, mesh.F.rows() - 1);
+  mesh.F(0, 0) = 999;
+  EXPECT_THROW(ClosestPointTree{mesh}, Error);
+}
+
+}  // namespace
+}  // namespace subflow::geometry
