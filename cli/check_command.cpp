@@ -65,15 +65,17 @@ Command AddCheckCommand(CLI::App& app) {
   auto settings = std::make_shared<CheckSettings>();
   CLI::App* command = app.add_subcommand(
       "check",
-      "Validate a triangle mesh (.ply ascii/binary or .obj) and print its figures: counts, closedness and "
-      "boundary loops, manifoldness, orientation, components, Euler characteristic and genus, enclosed "
-      "volume, area, bounds, edge lengths, degenerate faces, and self-intersections found by CGAL and, "
-      "independently, by TetGen (-d).");
+      "Validate a triangle mesh (.ply or .obj): manifold, orientation, closedness, genus, volume, "
+      "self-intersections (CGAL and TetGen); exit status 0 when valid");
   command->add_option("MESH", settings->mesh_path, "The mesh file (.ply or .obj)")->required();
   command->add_flag("--json", settings->json, "Print the figures as one JSON object instead of text");
   command->add_flag("--no-self-intersections", settings->no_self_intersections,
                     "Skip the CGAL and TetGen self-intersection tests (the slowest part)");
   command->footer(
+      "Prints: element counts, closedness and boundary loops, manifoldness (fins, bowties), orientation "
+      "(consistent, outward), components, Euler characteristic and genus, signed enclosed volume, area, "
+      "bounds, edge lengths, degenerate faces, and the self-intersections found by CGAL's "
+      "Polygon_mesh_processing and, independently, by TetGen's -d switch, with whether they agree.\n"
       "A mesh is valid when its coordinates are finite, it is a 2-manifold (no edge with more than two "
       "faces, no bowtie vertex), consistently oriented, oriented outward if closed (positive enclosed "
       "volume), and neither self-intersection test finds an intersection. Open boundaries, degenerate "

@@ -15,12 +15,9 @@
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_facet_topology.h>
 #include <CGAL/Mesh_triangulation_3.h>
-#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
-#include <CGAL/Polygon_mesh_processing/orientation.h>
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Random.h>
-#include <CGAL/Surface_mesh.h>
 #include <CGAL/facets_in_complex_3_to_triangle_mesh.h>
+#include <Eigen/Geometry>
 
 #include "geometry/error.h"
 #include "geometry/isosurface.h"
@@ -36,9 +33,7 @@ using Triangulation =
 using Complex = CGAL::Mesh_complex_3_in_triangulation_3<Triangulation>;
 using Criteria = CGAL::Mesh_criteria_3<Triangulation>;
 using Point = Kernel::Point_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
 namespace params = CGAL::parameters;
-namespace PMP = CGAL::Polygon_mesh_processing;
 
 // Surface points are found by bisection on segments down to this length (voxels).
 constexpr double kIntersectionToleranceVoxels = 1e-3;
@@ -104,47 +99,25 @@ void InsertSeeds(const std::vector<IsosurfaceSeed>& seeds, const MeshDomain& dom
 }
 
 // The boundary facets of the complex as a closed, outward-oriented 2-manifold.
+// Mesh_3 labels every cell by the subdomain of its circumcentre, and a facet is in the
+// complex exactly when the circumcentres of its two cells (the ends of its dual Voronoi
+// edge) carry different labels; the soup orients each facet from the cell labelled 1
+// (inside) towards the one labelled 0, i.e. outwards, cavities included. Shared points are
+// merged by the soup, so MeshTopology can then verify manifoldness and orientation.
 TriangleMesh ExtractBoundary(const Complex& c3t3, const std::string& source) {
   std::vector<Point> points;
-  std::vector<std::array<std::size_t, 3>> triangles;
-  // Facets are oriented with the normal pointing from subdomain 1 (inside) to 0.
+  std::vector<std::array<int, 3>> triangles;
   CGAL::Mesh_3::internal::facets_in_complex_3_to_triangle_soup(c3t3, points, triangles);
   if (triangles.empty())
     ThrowError(source, "surface", "Mesh_3 produced no surface triangle");
-  if (!PMP::is_polygon_soup_a_polygon_mesh(triangles)) {
-    const size_t point_count = points.size();
-    PMP::orient_polygon_soup(points, triangles);
-    // orient_polygon_soup duplicates the vertices where the surface is not a 2-manifold.
-    if (points.size() != point_count)
-      ThrowError(source, "surface",
-                 "the extracted surface has " + std::to_string(points.size() - point_count) +
-                     " non-manifold vertices; try a smaller facet_size_voxels");
-  }
-  SurfaceMesh mesh;
-  PMP::polygon_soup_to_polygon_mesh(points, triangles, mesh);
-  if (!CGAL::is_closed(mesh))
-    ThrowError(source, "surface",
-               "the extracted surface is not closed; try a smaller facet_size_voxels or a "
-               "larger max_vertex_count");
-  // Restricted Delaunay facets never intersect, so the precondition (closed, no
-  // self-intersection) holds; this also orients nested components (cavities) correctly.
-  PMP::orient_to_bound_a_volume(mesh);
-
-  TriangleMesh result;
-  result.V.resize(mesh.number_of_vertices(), 3);
-  for (const SurfaceMesh::Vertex_index v : mesh.vertices()) {
-    const Point& p = mesh.point(v);
-    result.V.row(static_cast<int>(v)) << p.x(), p.y(), p.z();
-  }
-  result.F.resize(mesh.number_of_faces(), 3);
-  int row = 0;
-  for (const SurfaceMesh::Face_index f : mesh.faces()) {
-    int k = 0;
-    for (const SurfaceMesh::Vertex_index v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
-      result.F(row, k++) = static_cast<int>(v);
-    ++row;
-  }
-  return result;
+  TriangleMesh mesh;
+  mesh.V.resize(static_cast<int>(points.size()), 3);
+  for (size_t v = 0; v < points.size(); ++v)
+    mesh.V.row(static_cast<int>(v)) << points[v].x(), points[v].y(), points[v].z();
+  mesh.F.resize(static_cast<int>(triangles.size()), 3);
+  for (size_t f = 0; f < triangles.size(); ++f)
+    mesh.F.row(static_cast<int>(f)) << triangles[f][0], triangles[f][1], triangles[f][2];
+  return mesh;
 }
 
 }  // namespace
@@ -206,10 +179,19 @@ TriangleMesh ExtractIsosurface(const ScalarVolume& volume, const IsosurfaceOptio
 
   start = std::chrono::steady_clock::now();
   TriangleMesh mesh = ExtractBoundary(c3t3, source);
-  // The one check that matters downstream: an oriented, closed 2-manifold (throws if not).
+  // What matters downstream: a closed, consistently oriented 2-manifold (MeshTopology throws
+  // on a non-manifold edge or vertex and on flipped neighbours) bounding a positive volume.
   const MeshTopology topology(mesh.F, mesh.vertex_count(), source + " (iso-surface)");
   if (!topology.IsClosed())
-    ThrowError(source, "surface", "the extracted surface has boundary edges");
+    ThrowError(source, "surface",
+               "the extracted surface has " + std::to_string(topology.BoundaryEdgeCount()) +
+                   " boundary edges; try a smaller facet_size_voxels or a larger "
+                   "max_vertex_count");
+  double signed_volume = 0.0;
+  for (int f = 0; f < mesh.face_count(); ++f)
+    signed_volume += mesh.V.row(mesh.F(f, 0)).dot(
+        mesh.V.row(mesh.F(f, 1)).cross(mesh.V.row(mesh.F(f, 2))));
+  SUBFLOW_CHECK(signed_volume > 0.0, "Mesh_3 facets must be oriented outwards");
   stats.vertex_count = mesh.vertex_count();
   stats.face_count = mesh.face_count();
   stats.extract_seconds = SecondsSince(start);

@@ -266,22 +266,25 @@ LocalPatch CanonicalPatch(const LocalPatch& patch, std::vector<int>* structure,
   canonical.reference = patch.reference;
   canonical.offsets.resize(patch.local_count(), patch.offsets.cols());
   for (int i = 0; i < patch.local_count(); ++i) canonical.offsets.row(i) = patch.offsets.row(order[i]);
-  if (structure) structure->clear();
   for (int i = 0; i < 3; ++i) {
     canonical.corner[i] = IndexIn(order, patch.corner[i]);
     canonical.boundary[i] = patch.boundary[i];
     for (const int r : patch.ring[i]) canonical.ring[i].push_back(IndexIn(order, r));
-    if (structure) {
+  }
+  if (structure) {
+    structure->clear();
+    for (int i = 0; i < 3; ++i) {
       const std::vector<int>& ring = canonical.ring[i];
       const int n = static_cast<int>(ring.size());
       const int start = patch.boundary[i] ? 0 : IndexIn(ring, canonical.corner[(i + 1) % 3]);
+      SUBFLOW_CHECK(start >= 0, "patch corner ring does not contain the next corner");
       structure->push_back(canonical.corner[i]);
       structure->push_back(patch.boundary[i] ? 1 : 0);
       structure->push_back(n);
       for (int k = 0; k < n; ++k) structure->push_back(ring[(start + k) % n]);
     }
+    structure->push_back(patch.local_count());
   }
-  if (structure) structure->push_back(patch.local_count());
   if (order_out) *order_out = order;
   return canonical;
 }

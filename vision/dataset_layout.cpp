@@ -147,11 +147,10 @@ void CheckImageSize(const cv::Mat& image, const Camera& camera, const std::strin
 }
 
 cv::Mat ReadImageFile(const std::string& path, const Camera& camera) {
+  if (!fs::is_regular_file(path)) ThrowError(path, "", "missing image file");
   cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty())
-    ThrowError(path, "", fs::exists(path) ? "unreadable image (cv::imread failed; expected an 8- or "
-                                            "16-bit PNG)"
-                                          : "missing image file");
+    ThrowError(path, "", "unreadable image (cv::imread failed; expected an 8- or 16-bit PNG)");
   if ((image.depth() != CV_8U && image.depth() != CV_16U) ||
       (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
     ThrowError(path, "pixel type",
@@ -165,7 +164,6 @@ namespace {
 
 DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers) {
   DatasetLayout layout;
-
   layout.directory = directory;
   const fs::path root(directory);
   if (!fs::is_directory(root))

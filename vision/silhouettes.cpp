@@ -60,8 +60,9 @@ cv::Mat Smooth(const cv::Mat& gray, double sigma) {
   return smoothed;
 }
 
-double AutomaticThreshold(const cv::Mat& measure, double fixed, double minimum) {
-  return fixed >= 0 ? fixed : std::max(OtsuThreshold(measure), minimum);
+double AutomaticThreshold(const cv::Mat& measure, double fixed, ThresholdMethod method, double minimum) {
+  if (fixed >= 0) return fixed;
+  return std::max(method == ThresholdMethod::kOtsu ? OtsuThreshold(measure) : TriangleThreshold(measure), minimum);
 }
 
 }  // namespace
@@ -108,8 +109,14 @@ void SilhouetteOptions::Check() const {
              min_object_pixels);
 }
 
-double OtsuThreshold(const cv::Mat& values) {
-  SUBFLOW_CHECK(values.type() == CV_32FC1, "OtsuThreshold expects CV_32FC1");
+namespace {
+
+constexpr int kHistogramBins = 256;
+
+// Histogram of the finite values of a CV_32FC1 image over [lo, the 99.9th percentile]
+// (values above fall into the last bin); false when the values are constant.
+bool Histogram(const cv::Mat& values, std::vector<double>* counts, double* lo, double* bin_width) {
+  SUBFLOW_CHECK(values.type() == CV_32FC1, "automatic thresholds expect CV_32FC1");
   std::vector<float> finite;
   finite.reserve(values.total());
   for (int y = 0; y < values.rows; ++y) {
@@ -117,29 +124,37 @@ double OtsuThreshold(const cv::Mat& values) {
     for (int x = 0; x < values.cols; ++x)
       if (std::isfinite(row[x])) finite.push_back(row[x]);
   }
-  if (finite.empty()) return 0.0;
-  const double lo = *std::min_element(finite.begin(), finite.end());
+  if (finite.empty()) {
+    *lo = 0;
+    return false;
+  }
+  *lo = *std::min_element(finite.begin(), finite.end());
   // The top of the histogram is a high percentile, not the maximum, so that a few
   // outliers do not squeeze the object's values into the lowest bins.
   std::vector<float> sorted = finite;
   const size_t top = std::min(sorted.size() - 1, static_cast<size_t>(0.999 * sorted.size()));
   std::nth_element(sorted.begin(), sorted.begin() + top, sorted.end());
   double hi = sorted[top];
-  if (!(hi > lo)) hi = *std::max_element(finite.begin(), finite.end());
-  if (!(hi > lo)) return lo;
-  constexpr int kBins = 256;
-  std::vector<double> histogram(kBins, 0.0);
-  const double bin_width = (hi - lo) / kBins;
-  for (float v : finite) {
-    const int bin = std::clamp(static_cast<int>((v - lo) / bin_width), 0, kBins - 1);
-    histogram[bin] += 1.0;
-  }
-  const double total = static_cast<double>(finite.size());
-  double sum_all = 0;
-  for (int b = 0; b < kBins; ++b) sum_all += b * histogram[b];
+  if (!(hi > *lo)) hi = *std::max_element(finite.begin(), finite.end());
+  if (!(hi > *lo)) return false;
+  counts->assign(kHistogramBins, 0.0);
+  *bin_width = (hi - *lo) / kHistogramBins;
+  for (float v : finite)
+    (*counts)[std::clamp(static_cast<int>((v - *lo) / *bin_width), 0, kHistogramBins - 1)] += 1.0;
+  return true;
+}
+
+}  // namespace
+
+double OtsuThreshold(const cv::Mat& values) {
+  std::vector<double> histogram;
+  double lo = 0, bin_width = 0;
+  if (!Histogram(values, &histogram, &lo, &bin_width)) return lo;
+  double total = 0, sum_all = 0;
+  for (int b = 0; b < kHistogramBins; ++b) total += histogram[b], sum_all += b * histogram[b];
   double weight_low = 0, sum_low = 0, best_variance = -1;
   int best_bin = 0;
-  for (int b = 0; b < kBins - 1; ++b) {
+  for (int b = 0; b < kHistogramBins - 1; ++b) {
     weight_low += histogram[b];
     sum_low += b * histogram[b];
     const double weight_high = total - weight_low;
@@ -154,6 +169,28 @@ double OtsuThreshold(const cv::Mat& values) {
   }
   // The classes are {bins ≤ best_bin} and {bins > best_bin}: threshold at the bin's top edge.
   return lo + (best_bin + 1) * bin_width;
+}
+
+double TriangleThreshold(const cv::Mat& values) {
+  std::vector<double> histogram;
+  double lo = 0, bin_width = 0;
+  if (!Histogram(values, &histogram, &lo, &bin_width)) return lo;
+  const int peak = static_cast<int>(std::max_element(histogram.begin(), histogram.end()) - histogram.begin());
+  int end = kHistogramBins - 1;  // the tail's end: the last non-empty bin above the peak
+  while (end > peak && histogram[end] == 0) --end;
+  if (end == peak) return lo + (peak + 1) * bin_width;
+  // The bin farthest below the chord from (peak, h[peak]) to (end, h[end]).
+  const double dx = end - peak, dy = histogram[end] - histogram[peak];
+  double best_distance = -1;
+  int best_bin = peak;
+  for (int b = peak + 1; b <= end; ++b) {
+    const double distance = dy * (b - peak) - dx * (histogram[b] - histogram[peak]);  // ∝ distance below
+    if (distance > best_distance) {
+      best_distance = distance;
+      best_bin = b;
+    }
+  }
+  return lo + best_bin * bin_width;
 }
 
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
@@ -215,7 +252,7 @@ Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& backgro
                                     const SilhouetteOptions& options) {
   const cv::Mat measure = Smooth(BackgroundDifference(image, background),
                                  options.background_blur_sigma);
-  const double threshold = AutomaticThreshold(measure, options.background_threshold,
+  const double threshold = AutomaticThreshold(measure, options.background_threshold, options.background_method,
                                               options.background_min_threshold);
   Silhouette silhouette = ThresholdAndClean(measure, threshold, options);
   silhouette.source = EvidenceSource::kBackground;
@@ -258,7 +295,7 @@ Silhouette SilhouetteFromMotion(const std::vector<cv::Mat>& gray_frames, int ind
                                 const SilhouetteOptions& options) {
   const cv::Mat measure = MotionEvidence(gray_frames, index, options);
   const double threshold =
-      AutomaticThreshold(measure, options.motion_threshold, options.motion_min_threshold);
+      AutomaticThreshold(measure, options.motion_threshold, options.motion_method, options.motion_min_threshold);
   Silhouette silhouette = ThresholdAndClean(measure, threshold, options);
   silhouette.source = EvidenceSource::kMotion;
   return silhouette;

@@ -46,6 +46,12 @@ std::string ToString(EvidenceSource source);
 // Inverse of ToString; throws subflow::Error naming `field` on anything else.
 EvidenceSource ParseEvidenceSource(const std::string& text, const std::string& field = "source");
 
+// Automatic thresholds of a measure image (see OtsuThreshold, TriangleThreshold).
+enum class ThresholdMethod {
+  kOtsu,      // two classes of maximal between-class variance: for two well-separated modes
+  kTriangle,  // the foot of the dominant (background) peak: for a peak plus a long tail
+};
+
 struct SilhouetteOptions {
   // Which evidence to use. kAuto takes, per camera, the first of mask / background /
   // motion that the dataset offers; a forced source that the dataset lacks is an error.
@@ -56,8 +62,12 @@ struct SilhouetteOptions {
   // half-pixel edge effects). 0 = no blur.
   double background_blur_sigma = 1.0;
   // Threshold on the blurred difference (intensity units, [0, 1]); < 0 = automatic
-  // (Otsu on the difference image, but never below background_min_threshold).
+  // (background_method on the difference image, never below background_min_threshold).
   double background_threshold = -1.0;
+  // Automatic method for the background difference. Triangle: the difference image is a
+  // peak of background noise plus a long tail of object pixels whose shaded parts come
+  // close to the background; Otsu splits the object's bright and dark parts instead.
+  ThresholdMethod background_method = ThresholdMethod::kTriangle;
   // Lower bound of the automatic threshold: differences below this are always noise
   // (0.02 ≈ 5 gray levels of an 8-bit image). Keeps Otsu from splitting pure noise when
   // the object is absent.
@@ -72,9 +82,10 @@ struct SilhouetteOptions {
   // Half-width w of the temporal window: θ is accumulated over frames f−w .. f+w
   // (clipped to the sequence). Larger windows fill in points that pause.
   int motion_window = 2;
-  // Threshold on the accumulated θ; < 0 = automatic (Otsu, never below
+  // Threshold on the accumulated θ; < 0 = automatic (motion_method, never below
   // motion_min_threshold).
   double motion_threshold = -1.0;
+  ThresholdMethod motion_method = ThresholdMethod::kOtsu;
   // Lower bound of the automatic motion threshold (θ units). A static scene gives θ = 0
   // up to image noise; θ below this is no motion.
   double motion_min_threshold = 0.5;
@@ -114,10 +125,14 @@ struct Silhouette {
 };
 
 // Otsu's threshold of a CV_32FC1 image: the value t maximizing the between-class
-// variance of {v ≤ t} and {v > t}, from a 256-bin histogram over [0, the 99.9th
-// percentile] (values outside clamped to the end bins). Returns 0 when the image is
-// constant. Non-finite values are ignored.
+// variance of {v ≤ t} and {v > t}, from a 256-bin histogram over [min, the 99.9th
+// percentile] (values above fall into the last bin). Returns the value itself when the
+// image is constant. Non-finite values are ignored.
 double OtsuThreshold(const cv::Mat& values);
+// The triangle threshold (Zack et al. 1977) of the same histogram: the bin farthest below
+// the chord from the histogram's peak to the end of its tail on the high side, i.e. the
+// foot of the peak. Suits a dominant background peak with a long tail of object values.
+double TriangleThreshold(const cv::Mat& values);
 
 // Silhouette from a given mask (CV_8UC1, non-zero = object). No cleaning.
 Silhouette SilhouetteFromMask(const cv::Mat& mask, const SilhouetteOptions& options = {});

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include <Eigen/Dense>
 
@@ -10,6 +11,13 @@
 
 namespace subflow::vision {
 namespace {
+
+std::string Format(double value) {
+  std::ostringstream out;
+  out.precision(4);
+  out << value;
+  return out.str();
+}
 
 // Counts, for every point of a res³ grid over [lo, hi], the cameras that see it, and
 // returns the bounding box of the points seen by ≥ min_views cameras (invalid if none).
@@ -89,7 +97,10 @@ Bounds EstimateWorkingVolume(const std::vector<Camera>& cameras,
     double spread = 0;
     for (const Camera& camera : cameras) spread = std::max(spread, (camera.Center() - mean_center).norm());
     if (spread == 0) spread = 1;
-    look_at = mean_center + 5 * spread * mean_direction.normalized();
+    // Opposed cameras on one axis cancel: then look along the first camera's axis.
+    const Eigen::Vector3d ahead = mean_direction.norm() > 1e-6 ? mean_direction.normalized()
+                                                              : cameras[0].ViewDirection().normalized();
+    look_at = mean_center + 5 * spread * ahead;
   }
 
   // 2. Sampling cube around the look-at point.
@@ -106,7 +117,7 @@ Bounds EstimateWorkingVolume(const std::vector<Camera>& cameras,
                           min_views, near_depth, &cell);
   if (!(coarse.min.array() <= coarse.max.array()).all())
     ThrowError(source, "bounds",
-               "absent, and no point of the " + std::to_string(2 * half_size) +
+               "absent, and no point of the " + Format(2 * half_size) +
                    "-wide cube around the cameras' look-at point is seen by " +
                    std::to_string(min_views) + " of the " + std::to_string(n) +
                    " cameras; give \"bounds\" explicitly");

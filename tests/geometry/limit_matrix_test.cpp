@@ -7,6 +7,7 @@
 // limit_evaluation_test.cpp.)
 #include <cmath>
 #include <random>
+#include <set>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -102,11 +103,15 @@ TEST(LoopLimitEvaluator, StamPatchesAgreeWithLocalRefinement) {
               << "face " << f << " (" << u << ", " << v << ") derivative " << r;
       }
     }
-    // Every face touching an isolated extraordinary vertex is a Stam patch.
+    // Every face touching an isolated extraordinary vertex is a Stam patch, and patches
+    // of the same valence share one subdivision matrix.
     if (static_cast<int>(m) < kIsolatedMeshCount) {
       int expected = 0;
-      for (int v = 0; v < n; ++v) expected += topology.Valence(v) != 6 ? topology.Valence(v) : 0;
+      std::set<int> valences;
+      for (int v = 0; v < n; ++v)
+        if (topology.Valence(v) != 6) expected += topology.Valence(v), valences.insert(topology.Valence(v));
       EXPECT_EQ(stam_faces, expected) << "mesh " << m;
+      EXPECT_EQ(stam.StamPatchCount(), static_cast<int>(valences.size())) << "mesh " << m;
     } else {
       EXPECT_EQ(stam_faces, 0) << "mesh " << m;
     }

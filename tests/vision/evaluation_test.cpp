@@ -2,6 +2,7 @@
 // the true shapes without motion — and clear errors on malformed results.
 #include "vision/evaluation.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -86,6 +87,8 @@ TEST(Evaluation, AccuracyOfACopyInflatedAlongItsNormalsIsTheInflation) {
     EXPECT_NEAR(frame.surface.hausdorff, delta, 0.1 * delta);
   }
   EXPECT_NEAR(report.overall.surface.accuracy, delta, 0.02 * delta);
+  std::printf("inflated by %.4g: accuracy %.6g, chamfer %.6g, hausdorff %.6g\n", delta,
+              report.overall.surface.accuracy, report.overall.surface.chamfer, report.overall.surface.hausdorff);
   // Completeness: the default threshold (1 % of a 0.2 m box diagonal ≈ 3.5 mm) covers δ.
   EXPECT_GT(report.threshold, 3 * delta);
   EXPECT_DOUBLE_EQ(report.overall.surface.completeness, 1.0);
@@ -140,6 +143,8 @@ TEST(Evaluation, FlowIsMeasuredAtTheClosestMaterialPoint) {
   const EvaluationReport report = EvaluateSequence(
       2, [&](int f) { return coarse.Mesh(f); },
       [&](int f) { return EvaluationFrame{fine.Mesh(f), motion[f]}; }, SmallOptions());
+  std::printf("analytic flow at another resolution: relative EPE %.4f (mean EPE %.3g, true %.3g)\n",
+              report.overall.flow.epe_relative, report.overall.flow.epe_mean, report.overall.flow.true_motion_mean);
   EXPECT_LT(report.overall.flow.epe_relative, 0.05);
   const std::vector<Positions> still = {Positions::Zero(fine.rest.rows(), 3), Positions::Zero(fine.rest.rows(), 3)};
   const EvaluationReport none = EvaluateSequence(

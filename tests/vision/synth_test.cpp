@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 

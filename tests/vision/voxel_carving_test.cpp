@@ -13,6 +13,8 @@
 #include <opencv2/calib3d.hpp>
 
 #include "geometry/error.h"
+#include "geometry/mesh_io.h"
+#include "vision/dataset.h"
 #include "vision/voxel_morphology.h"
 
 namespace subflow::vision {
@@ -361,6 +363,72 @@ TEST(VoxelGrid, CoversTheBoundsWithCubicVoxels) {
   EXPECT_NEAR(grid.origin.x(), -0.95, 1e-12);
   EXPECT_NEAR(grid.VoxelCenter(19, 9, 2).x(), 0.95, 1e-12);
   EXPECT_NEAR(grid.origin.z(), 0.05, 1e-12);
+}
+
+// ---- the blob dataset (../shared/data/blob), frame 0, from each source of evidence ----
+
+// Occupancy at X by trilinear interpolation of the voxel centres' values (0 outside the
+// grid): ≥ 0.5 means X is inside the iso-surface at 0.5 that the mesher extracts.
+double TrilinearOccupancy(const ScalarVolume& volume, const Eigen::Vector3d& X) {
+  const Eigen::Vector3d g = (X - volume.origin) / volume.spacing;
+  const Eigen::Vector3d f = g.array().floor();
+  double value = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3i c = f.cast<int>() + Eigen::Vector3i(corner & 1, (corner >> 1) & 1, corner >> 2);
+    if (!volume.InRange(c.x(), c.y(), c.z())) continue;
+    const Eigen::Vector3d w = (Eigen::Vector3d::Ones() - (g - c.cast<double>()).cwiseAbs());
+    value += w.prod() * volume.at(c.x(), c.y(), c.z());
+  }
+  return value;
+}
+
+struct BlobFigures {
+  double inside_fraction = 0;  // GT vertices inside the occupancy (trilinear ≥ 0.5)
+  double volume_ratio = 0;     // occupied volume / GT mesh volume
+  double mean_iou = 0;
+  CarvingResult result;
+};
+
+BlobFigures CarveBlob(EvidenceSource source) {
+  const Dataset dataset(SUBFLOW_SHARED_DIR "/data/blob");
+  SilhouetteOptions silhouette_options;
+  silhouette_options.source = source;
+  VoxelCarvingOptions carving_options;
+  carving_options.resolution = 64;  // 4.2 mm voxels ≈ 3 px: modest, for test time
+  BlobFigures figures;
+  figures.result = CarveFrame(dataset, 0, silhouette_options, carving_options);
+  const geometry::TriangleMesh truth = geometry::ReadMesh(dataset.GroundTruthMeshPath(0));
+  size_t inside = 0;
+  for (int v = 0; v < truth.V.rows(); ++v)
+    inside += TrilinearOccupancy(figures.result.occupancy, truth.V.row(v).transpose()) >= 0.5;
+  figures.inside_fraction = static_cast<double>(inside) / truth.V.rows();
+  double volume = 0;  // divergence theorem over the closed, outward-oriented GT mesh
+  for (int f = 0; f < truth.F.rows(); ++f)
+    volume += truth.V.row(truth.F(f, 0)).dot(truth.V.row(truth.F(f, 1)).cross(truth.V.row(truth.F(f, 2)))) / 6.0;
+  figures.volume_ratio =
+      figures.result.occupied_voxels * std::pow(figures.result.occupancy.spacing, 3) / std::abs(volume);
+  figures.mean_iou = figures.result.mean_silhouette_iou;
+  std::printf("[ figures ] blob frame 0 from %s: GT vertices inside %.4f, volume / GT volume %.3f, "
+              "mean silhouette IoU %.4f, occupied %zu of %zu voxels, max_misses %d\n",
+              ToString(source).c_str(), figures.inside_fraction, figures.volume_ratio, figures.mean_iou,
+              figures.result.occupied_voxels, figures.result.occupancy.size(), figures.result.max_misses);
+  for (const CameraCarvingReport& camera : figures.result.cameras)
+    std::printf("            %s: %s, %d px, IoU %.4f\n", camera.name.c_str(), ToString(camera.source).c_str(),
+                camera.object_pixels, camera.silhouette_iou);
+  return figures;
+}
+
+TEST(VoxelCarvingBlob, FromMasks) {
+  const BlobFigures figures = CarveBlob(EvidenceSource::kMask);
+  EXPECT_TRUE(figures.result.warnings.empty());
+}
+
+TEST(VoxelCarvingBlob, FromBackgroundDifference) {
+  const BlobFigures figures = CarveBlob(EvidenceSource::kBackground);
+}
+
+TEST(VoxelCarvingBlob, FromMotionEvidence) {
+  const BlobFigures figures = CarveBlob(EvidenceSource::kMotion);
 }
 
 // ---- morphology and components ----
