@@ -59,16 +59,23 @@ std::array<Combination, 12> BoxSplineControls(const LocalPatch& patch) {
   return controls;
 }
 
-// One vertex of the refined patch: its key (the corner it copies, or the edge it splits)
-// and its stencil over the coarse patch's local vertices.
-struct NewVertex {
-  int a, b;  // a == b: even copy of local vertex a; else odd vertex of edge {a, b}
-  std::vector<std::pair<int, double>> stencil;
-};
-
+// The refined vertices of a patch: even copies of the corners and odd vertices on every
+// edge at a corner, each keyed by the corner it copies or the edge it splits, with its
+// stencil over the coarse patch's local vertices (stored flat: few, short stencils).
 class Refinement {
  public:
+  struct Term {
+    int coarse;
+    double weight;
+  };
+
   explicit Refinement(const LocalPatch& patch) : patch_(patch) {
+    size_t ring_total = 0;
+    for (int i = 0; i < 3; ++i) ring_total += patch.ring[i].size();
+    keys_.reserve(ring_total + 3);
+    begin_.reserve(ring_total + 4);
+    terms_.reserve(4 * ring_total + 16);
+    begin_.push_back(0);
     for (int i = 0; i < 3; ++i) AddCornerVertices(i);
   }
 
@@ -92,25 +99,25 @@ class Refinement {
 
   std::vector<int> EvenRing(int i) const {
     std::vector<int> ring;
+    ring.reserve(patch_.ring[i].size());
     for (const int r : patch_.ring[i]) ring.push_back(Odd(patch_.corner[i], r));
     return ring;
   }
 
-  const NewVertex& vertex(int id) const { return vertices_[id]; }
+  const Term* TermsBegin(int id) const { return terms_.data() + begin_[id]; }
+  const Term* TermsEnd(int id) const { return terms_.data() + begin_[id + 1]; }
 
  private:
+  static std::pair<int, int> Key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
   int Find(int a, int b) const {
-    if (a > b) std::swap(a, b);
-    for (size_t i = 0; i < vertices_.size(); ++i)
-      if (vertices_[i].a == a && vertices_[i].b == b) return static_cast<int>(i);
-    SUBFLOW_CHECK(false, "refined vertex missing from the local patch");
-    return -1;
+    const auto it = std::find(keys_.begin(), keys_.end(), Key(a, b));
+    SUBFLOW_CHECK(it != keys_.end(), "refined vertex missing from the local patch");
+    return static_cast<int>(it - keys_.begin());
   }
-  bool Has(int a, int b) const {
-    if (a > b) std::swap(a, b);
-    for (const NewVertex& v : vertices_)
-      if (v.a == a && v.b == b) return true;
-    return false;
+  bool Has(int a, int b) const { return std::find(keys_.begin(), keys_.end(), Key(a, b)) != keys_.end(); }
+  void Close(int a, int b) {
+    keys_.push_back(Key(a, b));
+    begin_.push_back(static_cast<int>(terms_.size()));
   }
 
   void AddCornerVertices(int i) {
@@ -118,29 +125,29 @@ class Refinement {
     const std::vector<int>& ring = patch_.ring[i];
     const int n = static_cast<int>(ring.size());
     const bool boundary = patch_.boundary[i];
-    NewVertex even{c, c, {}};
     if (boundary) {
-      even.stencil = {{c, 0.75}, {ring.front(), 0.125}, {ring.back(), 0.125}};
+      terms_.insert(terms_.end(), {{c, 0.75}, {ring.front(), 0.125}, {ring.back(), 0.125}});
     } else {
       const double alpha = LoopRingWeight(n);
-      even.stencil.push_back({c, 1.0 - alpha});
-      for (const int r : ring) even.stencil.push_back({r, alpha / n});
+      terms_.push_back({c, 1.0 - alpha});
+      for (const int r : ring) terms_.push_back({r, alpha / n});
     }
-    vertices_.push_back(std::move(even));
+    Close(c, c);
     for (int k = 0; k < n; ++k) {
       if (Has(c, ring[k])) continue;
-      NewVertex odd{std::min(c, ring[k]), std::max(c, ring[k]), {}};
       if (boundary && (k == 0 || k == n - 1))
-        odd.stencil = {{c, 0.5}, {ring[k], 0.5}};
+        terms_.insert(terms_.end(), {{c, 0.5}, {ring[k], 0.5}});
       else
-        odd.stencil = {{c, 0.375}, {ring[k], 0.375}, {ring[(k - 1 + n) % n], 0.125},
-                       {ring[(k + 1) % n], 0.125}};
-      vertices_.push_back(std::move(odd));
+        terms_.insert(terms_.end(), {{c, 0.375}, {ring[k], 0.375}, {ring[(k - 1 + n) % n], 0.125},
+                                     {ring[(k + 1) % n], 0.125}});
+      Close(c, ring[k]);
     }
   }
 
   const LocalPatch& patch_;
-  std::vector<NewVertex> vertices_;
+  std::vector<std::pair<int, int>> keys_;  // (a, a): even copy of a; (a < b): odd on edge ab
+  std::vector<int> begin_;                 // terms of vertex i: [begin_[i], begin_[i + 1])
+  std::vector<Term> terms_;
 };
 
 }  // namespace
@@ -166,7 +173,7 @@ LocalPatch PatchAroundFace(const MeshTopology& topology, int face) {
   }
   const int n = static_cast<int>(patch.support.size());
   patch.reference = Eigen::RowVectorXd::Unit(n, patch.corner[0]);
-  patch.offsets = Eigen::MatrixXd::Identity(n, n);
+  patch.offsets = StencilRows::Identity(n, n);
   patch.offsets.col(patch.corner[0]).array() -= 1.0;
   return patch;
 }
@@ -213,6 +220,7 @@ LocalPatch RefinePatch(const LocalPatch& patch, int child) {
   LocalPatch refined;
   refined.support = patch.support;
   std::vector<int> new_ids;  // refinement vertex id of each local vertex of the child
+  new_ids.reserve(24);
   auto local = [&new_ids](int id) {
     const int i = IndexIn(new_ids, id);
     if (i >= 0) return i;
@@ -235,11 +243,10 @@ LocalPatch RefinePatch(const LocalPatch& patch, int child) {
   }
 
   const int n = static_cast<int>(new_ids.size());
-  Eigen::MatrixXd stencils = Eigen::MatrixXd::Zero(n, patch.local_count());
-  for (int i = 0; i < n; ++i)
-    for (const auto& [coarse, weight] : refinement.vertex(new_ids[i]).stencil)
-      stencils(i, coarse) += weight;
-  refined.offsets = stencils * patch.offsets;
+  refined.offsets.setZero(n, patch.offsets.cols());
+  for (int i = 0; i < n; ++i)  // each refined vertex combines 2 to K + 1 coarse ones
+    for (auto t = refinement.TermsBegin(new_ids[i]); t != refinement.TermsEnd(new_ids[i]); ++t)
+      refined.offsets.row(i) += t->weight * patch.offsets.row(t->coarse);
   // Re-centre on the child's first corner so the offsets scale with the child.
   const Eigen::RowVectorXd shift = refined.offsets.row(refined.corner[0]);
   refined.reference = patch.reference + shift;

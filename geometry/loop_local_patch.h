@@ -38,10 +38,13 @@
 
 namespace subflow::geometry::loop_patch {
 
+// Rows are stencils; row-major so that refinement combines whole rows.
+using StencilRows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
 struct LocalPatch {
   std::vector<int> support;              // control vertex indices, distinct
   Eigen::RowVectorXd reference;          // 1 × #support
-  Eigen::MatrixXd offsets;               // #local × #support, rows sum to 0
+  StencilRows offsets;                   // #local × #support, rows sum to 0
   std::array<int, 3> corner{};           // local indices of C0, C1, C2
   std::array<std::vector<int>, 3> ring;  // local indices, ordered as described above
   std::array<bool, 3> boundary{};

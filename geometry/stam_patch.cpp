@@ -30,7 +30,7 @@ bool BuildStamPatch(const LocalPatch& canonical, StamPatch* patch) {
   unit.support.resize(k);
   for (int i = 0; i < k; ++i) unit.support[i] = i;
   unit.reference = Eigen::RowVectorXd::Unit(k, unit.corner[0]);
-  unit.offsets = Eigen::MatrixXd::Identity(k, k);
+  unit.offsets = StencilRows::Identity(k, k);
   unit.offsets.col(unit.corner[0]).array() -= 1.0;
 
   std::vector<int> structure, child_structure;

@@ -65,6 +65,8 @@ void NormalFlowSolverOptions::Check() const {
     ThrowError("normal flow solver", "reweighting_iterations", "expected 0..50");
   if (!std::isfinite(robust_threshold) || robust_threshold <= 0.0)
     ThrowError("normal flow solver", "robust_threshold", "expected a finite value > 0");
+  if (!finite_nonnegative(noise_floor))
+    ThrowError("normal flow solver", "noise_floor", "expected a finite value ≥ 0 (intensity)");
   if (collinearity_min_cameras < 3)
     ThrowError("normal flow solver", "collinearity_min_cameras",
                "expected ≥ 3 (two planes always intersect in a line)");
@@ -209,7 +211,7 @@ Eigen::VectorXd NormalFlowSolver::CollinearityWeights(const NormalFlowConstraint
   std::vector<double> tested_residuals;
   for (int c = 0; c < count; ++c)
     if (tested[c]) tested_residuals.push_back(residual(c));
-  const double sigma = 1.4826 * MedianAbs(tested_residuals);
+  const double sigma = std::max(1.4826 * MedianAbs(tested_residuals), options_.noise_floor);
   if (!(sigma > 0.0)) return weights;
   for (int c = 0; c < count; ++c) {
     if (!tested[c]) continue;
@@ -346,7 +348,7 @@ NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constrai
     std::vector<double> active;
     for (int c = 0; c < constraints.size(); ++c)
       if (solution.collinearity_weights(c) > 0.0) active.push_back(residual(c));
-    const double sigma = 1.4826 * MedianAbs(active);
+    const double sigma = std::max(1.4826 * MedianAbs(active), options_.noise_floor);
     if (!(sigma > 0.0)) break;
     solution.robust_scale = sigma;
     for (int c = 0; c < constraints.size(); ++c)

@@ -36,9 +36,9 @@
 //     collinearity_min_cameras, the rank-2 least-squares solution (the two largest
 //     eigen-directions of Σ g gᵀ) leaves a residual per constraint that measures how far
 //     the planes' pairwise intersection lines are from being collinear; constraints whose
-//     residual exceeds robust_threshold robust standard deviations (1.4826 · median
-//     absolute residual over all such constraints) are down-weighted by Tukey's biweight
-//     (zero beyond the threshold: pruned).
+//     residual exceeds robust_threshold robust standard deviations (σ = max(1.4826 ·
+//     median absolute residual over all such constraints, noise_floor)) are down-weighted
+//     by Tukey's biweight (zero beyond the threshold: pruned).
 //   * IRLS. After each solve, the residuals r_c = g_cᵀ (L D)_s − b_c of the whole field get
 //     Tukey weights with the same rule; the system is re-solved reweighting_iterations
 //     times. Final weight = collinearity weight × IRLS weight.
@@ -63,6 +63,9 @@ struct NormalFlowSolverOptions {
   int finest_level = -1;          // finest level whose details are solved; −1 = the finest
   int reweighting_iterations = 3; // IRLS re-solves after the first (0 = plain least squares)
   double robust_threshold = 4.685;  // Tukey constant in robust standard deviations
+  // Floor of the robust scale σ (intensity, images in [0, 1]): residuals this small are
+  // never outliers (≈ half a grey level of 255; keeps exact or noise-free data unpruned).
+  double noise_floor = 0.002;
   bool collinearity_pruning = true;
   int collinearity_min_cameras = 3;  // per-sample test needs K ≥ this (≥ 3: 2 planes always meet)
   double cg_tolerance = 1e-6;     // relative residual of each level's normal equations

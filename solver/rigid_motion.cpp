@@ -4,6 +4,7 @@
 #include <string>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include "geometry/error.h"
 

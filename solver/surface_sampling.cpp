@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include <Eigen/Geometry>
 #include <tbb/parallel_for.h>
 
 #include "geometry/error.h"

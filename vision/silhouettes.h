@@ -4,8 +4,9 @@
 //  1. kMask        given masks (masks/<camera>/<frame>.png): evidence = mask / 255.
 //  2. kBackground  the difference to the background image: per-pixel distance
 //                  d(p) = sqrt(Σ_c (I_c(p) − B_c(p))² / C) over the C colour channels of
-//                  intensities in [0, 1] (gray: |I − B|), Gaussian-blurred, thresholded
-//                  (Otsu on d, or a fixed value), then cleaned (2D closing, holes filled).
+//                  intensities in [0, 1] (gray: |I − B|), slightly Gaussian-blurred,
+//                  thresholded (automatic: triangle or Otsu on d; or a fixed value), then
+//                  cleaned (2D closing, small regions removed, holes filled).
 //  3. kMotion      motion evidence, method eq. 23, per pixel and frame g:
 //                      θ_g(p) = |∂I/∂t(p)| / (λ + ‖∇I(p)‖²)
 //                  with I the Gaussian-smoothed gray image (σ = motion_sigma), ∇I central
@@ -60,7 +61,7 @@ struct SilhouetteOptions {
   // --- background difference ---
   // σ (pixels) of the Gaussian blur of the difference image (suppresses pixel noise and
   // half-pixel edge effects). 0 = no blur.
-  double background_blur_sigma = 1.0;
+  double background_blur_sigma = 0.5;
   // Threshold on the blurred difference (intensity units, [0, 1]); < 0 = automatic
   // (background_method on the difference image, never below background_min_threshold).
   double background_threshold = -1.0;
@@ -69,8 +70,8 @@ struct SilhouetteOptions {
   // close to the background; Otsu splits the object's bright and dark parts instead.
   ThresholdMethod background_method = ThresholdMethod::kTriangle;
   // Lower bound of the automatic threshold: differences below this are always noise
-  // (0.02 ≈ 5 gray levels of an 8-bit image). Keeps Otsu from splitting pure noise when
-  // the object is absent.
+  // (0.02 ≈ 5 gray levels of an 8-bit image). Keeps the automatic threshold from
+  // splitting pure noise when the object is absent.
   double background_min_threshold = 0.02;
 
   // --- motion evidence (eq. 23) ---
@@ -92,8 +93,9 @@ struct SilhouetteOptions {
 
   // --- cleaning of thresholded background / motion evidence (not of given masks) ---
   // Radius (pixels) of the 2D morphological closing of the thresholded image (joins
-  // moving texture and contour fragments into one region). 0 = none.
-  int close_radius = 3;
+  // moving texture and contour fragments into one region, closes bites of weak evidence
+  // at the contour). Also closes real concavities narrower than 2r + 1 pixels. 0 = none.
+  int close_radius = 5;
   // Fill holes of the silhouette (background regions not connected to the image border).
   // Right for objects without through-holes; turn off for a torus seen through its hole.
   bool fill_holes = true;

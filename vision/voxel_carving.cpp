@@ -55,7 +55,7 @@ inline double BoxSum(const double* sums, size_t stride, int x0, int x1, int y0, 
 // looking at it. Only blocks straddling the silhouette's contour are visited voxel by
 // voxel, so the cost follows the object's surface, not its volume.
 void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingCamera>& used,
-                  const ScalarVolume& grid, double threshold, int max_misses,
+                  const ScalarVolume& grid, double threshold, float margin, int max_misses,
                   std::vector<uint16_t>* hits, std::vector<uint16_t>* misses) {
   constexpr int kSlab = 4, kBlock = 8;
   tbb::parallel_for(tbb::blocked_range<int>(0, grid.nz, kSlab), [&](const tbb::blocked_range<int>& range) {
@@ -94,10 +94,10 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
               projector.ProjectCorner(i_begin + (c % row), j_begin + (c % plane) / row, k0 + c / plane, &us[c], &vs[c]);
             float x_min, x_max, y_min, y_max;
             if (footprint(corners, &x_min, &x_max, &y_min, &y_max)) {
-              const int x0 = std::max(0, static_cast<int>(std::floor(x_min)));
-              const int x1 = std::min(width - 1, static_cast<int>(std::ceil(x_max)));
-              const int y0 = std::max(0, static_cast<int>(std::floor(y_min)));
-              const int y1 = std::min(height - 1, static_cast<int>(std::ceil(y_max)));
+              const int x0 = std::max(0, static_cast<int>(std::floor(x_min - margin)));
+              const int x1 = std::min(width - 1, static_cast<int>(std::ceil(x_max + margin)));
+              const int y0 = std::max(0, static_cast<int>(std::floor(y_min - margin)));
+              const int y1 = std::min(height - 1, static_cast<int>(std::ceil(y_max + margin)));
               const double sum = BoxSum(sums, stride, x0, x1, y0, y1);
               const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
               if (sum <= 0 || sum >= area) {
@@ -121,9 +121,12 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
                                            c0 + plane, c0 + plane + 1, c0 + plane + row, c0 + plane + row + 1};
                 float x_min, x_max, y_min, y_max;
                 if (!footprint(corners, &x_min, &x_max, &y_min, &y_max)) continue;
-                // Pixels whose centres lie in the footprint; per axis the nearest when none does.
-                int x0 = static_cast<int>(std::ceil(x_min)), x1 = static_cast<int>(std::floor(x_max));
-                int y0 = static_cast<int>(std::ceil(y_min)), y1 = static_cast<int>(std::floor(y_max));
+                // Pixels whose centres lie in the footprint grown by the margin (clipped to
+                // the image); per axis the nearest when none does.
+                int x0 = std::max(0, static_cast<int>(std::ceil(x_min - margin)));
+                int x1 = std::min(width - 1, static_cast<int>(std::floor(x_max + margin)));
+                int y0 = std::max(0, static_cast<int>(std::ceil(y_min - margin)));
+                int y1 = std::min(height - 1, static_cast<int>(std::floor(y_max + margin)));
                 if (x0 > x1) x0 = x1 = std::clamp(static_cast<int>(std::lround(0.5f * (x_min + x_max))), 0, width - 1);
                 if (y0 > y1) y0 = y1 = std::clamp(static_cast<int>(std::lround(0.5f * (y_min + y_max))), 0, height - 1);
                 const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
@@ -154,6 +157,7 @@ void VoxelCarvingOptions::Check() const {
   if (min_cameras < 1) fail("min_cameras", "at least 1", min_cameras);
   if (max_misses < -1) fail("max_misses", "-1 (automatic) or ≥ 0", max_misses);
   if (!(evidence_threshold > 0 && evidence_threshold <= 1)) fail("evidence_threshold", "a value in (0, 1]", evidence_threshold);
+  if (!(footprint_margin >= 0 && footprint_margin <= 100)) fail("footprint_margin", "a value in [0, 100] pixels", footprint_margin);
   if (closing_radius < 0 || closing_radius > 32) fail("closing_radius", "0..32 voxels", closing_radius);
   if (opening_radius < 0 || opening_radius > 32) fail("opening_radius", "0..32 voxels", opening_radius);
   if (connectivity != 6 && connectivity != 26) fail("connectivity", "6 or 26", connectivity);
@@ -255,7 +259,8 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic : options.threads);
   arena.execute([&] {
     std::vector<uint16_t> hits(occupancy.size(), 0), misses(occupancy.size(), 0);
-    CountSupport(cameras, used, occupancy, options.evidence_threshold, result.max_misses, &hits, &misses);
+    CountSupport(cameras, used, occupancy, options.evidence_threshold,
+                 static_cast<float>(options.footprint_margin), result.max_misses, &hits, &misses);
     for (size_t v = 0; v < occupancy.size(); ++v)
       occupied.values[v] = hits[v] >= options.min_cameras && misses[v] <= result.max_misses;
     result.carved_voxels = occupied.Count();

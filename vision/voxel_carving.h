@@ -15,14 +15,25 @@
 //              polynomial cannot fold back) and the footprint lies inside the image
 //              [−½, w − ½) × [−½, h − ½) (pixel (0, 0) = centre of the top-left pixel);
 //   evidence   e_k(V) = mean of the camera's evidence image over the pixels whose centres
-//              lie in the footprint (summed-area table, cv::integral, O(1) per voxel;
-//              along an axis where the footprint contains no pixel centre, the pixel
-//              row / column nearest its centre);
+//              lie in the footprint grown by footprint_margin pixels on each side and
+//              clipped to the image (summed-area table, cv::integral, O(1) per voxel;
+//              along an axis where that box contains no pixel centre, the pixel row /
+//              column nearest its centre);
 //   hit / miss e_k(V) ≥ evidence_threshold / below it.
 // V is occupied ⇔ hits(V) ≥ min_cameras and misses(V) ≤ max_misses. So a voxel is carved
 // only by the cameras that see it (a partial rig works), and a voxel seen by fewer than
 // min_cameras cameras is NOT occupied: one view alone cannot locate anything along its
 // rays, so such voxels (e.g. the corners of the volume outside most frusta) stay empty.
+//
+// The defaults make the hull CONSERVATIVE: it contains the true visual hull, and so the
+// object. A voxel is kept when its cube's projection (inside the footprint) reaches the
+// silhouette at all (evidence_threshold small), and the ½-pixel margin covers the
+// sampling of silhouettes at pixel centres (a contour is known to ±½ pixel). Hence every
+// voxel whose centre lies in the visual hull is occupied, the iso-surface at ½ of the
+// occupancy (half-way between occupied and empty centres) encloses the hull, and it lies
+// outside the hull by at most ~(√3/2 + ½) voxel + 1 pixel. evidence_threshold = 0.5 and
+// no margin would instead centre the boundary on the silhouette cones (unbiased, but
+// about half of the surface would then fall inside the object by up to half a voxel).
 //
 // Cleaning (in this order): closing then opening with a (2r + 1)³ box, keep connected
 // components with ≥ min_component_fraction × the largest one's voxels, fill interior
@@ -69,9 +80,12 @@ struct VoxelCarvingOptions {
   // voxel is carved. −1 = automatic: 0 when every used camera's evidence is a given mask
   // (strict visual hull), else 1 (background and motion silhouettes have holes).
   int max_misses = -1;
-  // Fraction of a footprint that must be object for a camera to support a voxel. 0.5
-  // puts the hull's boundary on the silhouette cones (lower = larger, more conservative).
-  double evidence_threshold = 0.5;
+  // Fraction of a footprint's pixels that must be object for a camera to support a voxel.
+  // Small = conservative hull (see the file comment); 0.1 ignores a stray pixel or two.
+  double evidence_threshold = 0.1;
+  // Pixels added on each side of a footprint for the evidence mean (not for "sees"):
+  // ½ covers the pixel-centre sampling of silhouettes.
+  double footprint_margin = 0.5;
   // Radius (voxels) of the closing, then of the opening (box (2r + 1)³); 0 = skip.
   int closing_radius = 1;
   int opening_radius = 1;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <random>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "geometry/error.h"
