@@ -4,9 +4,8 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "cli/commands.h"
 #include "geometry/error.h"
@@ -37,7 +36,8 @@ void RunCheck(const CheckSettings& settings) {
   options.check_self_intersections_cgal = !settings.no_self_intersections;
   options.check_self_intersections_tetgen = !settings.no_self_intersections;
   const auto validate_start = std::chrono::steady_clock::now();
-  const geometry::MeshValidationReport report = geometry::ValidateMesh(mesh, options, settings.mesh_path);
+  const geometry::MeshValidationReport report =
+      geometry::ValidateMesh(mesh, options, settings.mesh_path);
   const double validate_seconds = SecondsSince(validate_start);
 
   if (settings.json) {
@@ -54,7 +54,8 @@ void RunCheck(const CheckSettings& settings) {
   std::cout.flush();
   if (!report.valid()) {
     std::string reasons;
-    for (const std::string& problem : report.problems) reasons += (reasons.empty() ? "" : "; ") + problem;
+    for (const std::string& problem : report.problems)
+      reasons += (reasons.empty() ? "" : "; ") + problem;
     ThrowError(settings.mesh_path, "", "invalid mesh: " + reasons);
   }
 }
@@ -68,17 +69,24 @@ Command AddCheckCommand(CLI::App& app) {
       "Validate a triangle mesh (.ply or .obj): manifold, orientation, closedness, genus, volume, "
       "self-intersections (CGAL and TetGen); exit status 0 when valid");
   command->add_option("MESH", settings->mesh_path, "The mesh file (.ply or .obj)")->required();
-  command->add_flag("--json", settings->json, "Print the figures as one JSON object instead of text");
+  command->add_flag("--json", settings->json,
+                    "Print the figures as one JSON object instead of text");
   command->add_flag("--no-self-intersections", settings->no_self_intersections,
                     "Skip the CGAL and TetGen self-intersection tests (the slowest part)");
   command->footer(
-      "Prints: element counts, closedness and boundary loops, manifoldness (fins, bowties), orientation "
-      "(consistent, outward), components, Euler characteristic and genus, signed enclosed volume, area, "
+      "Prints: element counts, closedness and boundary loops, manifoldness (fins, bowties), "
+      "orientation "
+      "(consistent, outward), components, Euler characteristic and genus, signed enclosed volume, "
+      "area, "
       "bounds, edge lengths, degenerate faces, and the self-intersections found by CGAL's "
-      "Polygon_mesh_processing and, independently, by TetGen's -d switch, with whether they agree.\n"
-      "A mesh is valid when its coordinates are finite, it is a 2-manifold (no edge with more than two "
-      "faces, no bowtie vertex), consistently oriented, oriented outward if closed (positive enclosed "
-      "volume), and neither self-intersection test finds an intersection. Open boundaries, degenerate "
+      "Polygon_mesh_processing and, independently, by TetGen's -d switch, with whether they "
+      "agree.\n"
+      "A mesh is valid when its coordinates are finite, it is a 2-manifold (no edge with more than "
+      "two "
+      "faces, no bowtie vertex), consistently oriented, oriented outward if closed (positive "
+      "enclosed "
+      "volume), and neither self-intersection test finds an intersection. Open boundaries, "
+      "degenerate "
       "faces and unused vertices are reported as warnings.\n"
       "Exit status: 0 valid; 1 invalid or unreadable (the reason on stderr in one line).");
   return {command, [settings] { RunCheck(*settings); }};

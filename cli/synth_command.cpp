@@ -38,9 +38,9 @@ Command AddSynthCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--noise", options->render.noise_sigma, "Gaussian sensor noise σ (grey levels of 255)")
       ->capture_default_str();
-  command->add_option("--color-cameras", options->colour_cameras, "Indices of the colour cameras (e.g. 0,4)")
-      ->delimiter(',')
-      ->capture_default_str();
+  auto colour_list = command->add_option("--color-cameras", options->colour_cameras,
+                                         "Indices of the colour cameras (default 0,4 where they exist)")
+                         ->delimiter(',');
   command->add_option("--color-every", options->colour_every,
                       "Every k-th camera is colour (overrides --color-cameras; 0 = off)")
       ->capture_default_str();
@@ -52,9 +52,19 @@ Command AddSynthCommand(CLI::App& app) {
   command->add_option("--subdivisions", options->scene.subdivisions, "Icosphere levels of the mesh")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Texture and noise seed")->capture_default_str();
+  auto all_gray = std::make_shared<bool>(false);
+  command->add_flag("--gray", *all_gray, "Every camera gray (no colour cameras)")->excludes(colour_list);
   command->add_flag("--overwrite", options->overwrite, "Replace the dataset in a non-empty directory");
 
-  return {command, [options, out] {
+  return {command, [options, out, colour_list, all_gray] {
+            if (*all_gray) {
+              options->colour_cameras.clear();
+            } else if (colour_list->count() == 0) {  // the defaults, where those cameras exist
+              std::vector<int> present;
+              for (int c : options->colour_cameras)
+                if (c < options->rig.camera_count) present.push_back(c);
+              options->colour_cameras = present;
+            }
             ProgressBar progress;
             const vision::SynthSummary summary = vision::WriteSyntheticDataset(*out, *options, &progress);
             std::cout << "synth " << options->scene.scene << ": " << summary.camera_count << " cameras ("

@@ -46,23 +46,27 @@ std::string ReadFileBytes(const std::string& path) {
 
 }  // namespace
 
-TriangleMesh ReadMesh(const std::string& path, const MeshReadOptions& options, VertexProperties* properties) {
+TriangleMesh ReadMesh(const std::string& path, const MeshReadOptions& options,
+                      VertexProperties* properties) {
   const FileKind kind = KindOf(path);
   const std::string bytes = ReadFileBytes(path);
   if (properties) *properties = VertexProperties{};
-  TriangleMesh mesh = kind == FileKind::kPly ? ParsePly(bytes, path, properties) : ParseObj(bytes, path);
-  if (options.require_manifold) MeshTopology(mesh.F, mesh.vertex_count(), path);  // throws naming `path`
+  TriangleMesh mesh =
+      kind == FileKind::kPly ? ParsePly(bytes, path, properties) : ParseObj(bytes, path);
+  if (options.require_manifold)
+    MeshTopology(mesh.F, mesh.vertex_count(), path);  // throws naming `path`
   return mesh;
 }
 
-void WriteMesh(const std::string& path, const TriangleMesh& mesh, const VertexProperties* properties,
-               PlyFormat ply_format) {
+void WriteMesh(const std::string& path, const TriangleMesh& mesh,
+               const VertexProperties* properties, PlyFormat ply_format) {
   const FileKind kind = KindOf(path);
   const fs::path parent = fs::path(path).parent_path();
   std::error_code error;
   if (!parent.empty() && !fs::is_directory(parent, error))
     ThrowError(path, "", "directory \"" + parent.string() + "\" does not exist");
-  if (mesh.V.cols() != 3 || mesh.F.cols() != 3) ThrowError(path, "mesh", "expected #V×3 positions and #F×3 faces");
+  if (mesh.V.cols() != 3 || mesh.F.cols() != 3)
+    ThrowError(path, "mesh", "expected #V×3 positions and #F×3 faces");
   for (int f = 0; f < mesh.face_count(); ++f)
     for (int k = 0; k < 3; ++k)
       if (mesh.F(f, k) < 0 || mesh.F(f, k) >= mesh.vertex_count())
@@ -70,16 +74,21 @@ void WriteMesh(const std::string& path, const TriangleMesh& mesh, const VertexPr
                    "vertex index " + std::to_string(mesh.F(f, k)) + " out of range [0, " +
                        std::to_string(mesh.vertex_count()) + ") (refusing to write it)");
   if (kind == FileKind::kObj && properties && !properties->values.empty())
-    ThrowError(path, "vertex properties", "OBJ cannot store per-vertex properties (write a .ply instead)");
+    ThrowError(path, "vertex properties",
+               "OBJ cannot store per-vertex properties (write a .ply instead)");
 
   // Write beside the destination and rename, so a reader never sees a half-written mesh.
   const std::string temporary = path + ".tmp";
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) ThrowError(path, "", "cannot open \"" + temporary + "\" for writing: " + std::strerror(errno));
+    if (!out)
+      ThrowError(path, "",
+                 "cannot open \"" + temporary + "\" for writing: " + std::strerror(errno));
     try {
-      if (kind == FileKind::kPly) WritePly(out, mesh, properties, ply_format, path);
-      else WriteObj(out, mesh, path);
+      if (kind == FileKind::kPly)
+        WritePly(out, mesh, properties, ply_format, path);
+      else
+        WriteObj(out, mesh, path);
       out.flush();
       if (!out) ThrowError(path, "", "write error (disk full?)");
     } catch (...) {

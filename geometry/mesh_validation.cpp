@@ -1,13 +1,13 @@
 #include "geometry/mesh_validation.h"
 
+#include <spdlog/fmt/fmt.h>
+
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numeric>
-
-#include <Eigen/Geometry>
-#include <spdlog/fmt/fmt.h>
 
 #include "geometry/error.h"
 #include "geometry/mesh_topology.h"
@@ -31,7 +31,8 @@ class UnionFind {
 // Combinatorics from the half-edges of the faces that do not repeat a vertex: edges,
 // boundary, fins, orientation, fans around vertices (via corners united across 2-face
 // edges), components and boundary loops.
-void MeasureTopology(const Faces& F, int n, const std::vector<char>& face_ok, MeshValidationReport* report) {
+void MeasureTopology(const Faces& F, int n, const std::vector<char>& face_ok,
+                     MeshValidationReport* report) {
   const int m = static_cast<int>(F.rows());
   struct Halfedge {
     std::uint64_t key;  // (min vertex << 32) | max vertex
@@ -46,8 +47,9 @@ void MeasureTopology(const Faces& F, int n, const std::vector<char>& face_ok, Me
       halfedges.push_back({(std::min(a, b) << 32) | std::max(a, b), 3 * f + k});
     }
   }
-  std::sort(halfedges.begin(), halfedges.end(),
-            [](const Halfedge& x, const Halfedge& y) { return x.key != y.key ? x.key < y.key : x.h < y.h; });
+  std::sort(halfedges.begin(), halfedges.end(), [](const Halfedge& x, const Halfedge& y) {
+    return x.key != y.key ? x.key < y.key : x.h < y.h;
+  });
   auto source = [&](int h) { return F(h / 3, h % 3); };
   auto target_corner = [](int h) { return 3 * (h / 3) + (h % 3 + 1) % 3; };
 
@@ -98,15 +100,18 @@ void MeasureTopology(const Faces& F, int n, const std::vector<char>& face_ok, Me
   report->unreferenced_vertex_count = n - referenced;
   report->euler_characteristic = referenced - report->edge_count + used_faces;
   report->closed = used_faces > 0 && report->boundary_edge_count == 0;
-  report->manifold = report->non_manifold_edge_count == 0 && report->non_manifold_vertex_count == 0 &&
+  report->manifold = report->non_manifold_edge_count == 0 &&
+                     report->non_manifold_vertex_count == 0 &&
                      report->repeated_vertex_face_count == 0;
   report->consistently_oriented = report->inconsistent_edge_count == 0;
   if (report->manifold && report->consistently_oriented)
-    report->genus = (2 * report->component_count - report->euler_characteristic - report->boundary_loop_count) / 2;
+    report->genus =
+        (2 * report->component_count - report->euler_characteristic - report->boundary_loop_count) /
+        2;
 }
 
-void MeasureGeometry(const TriangleMesh& mesh, const std::vector<char>& face_ok, double degenerate_area_tolerance,
-                     MeshValidationReport* report) {
+void MeasureGeometry(const TriangleMesh& mesh, const std::vector<char>& face_ok,
+                     double degenerate_area_tolerance, MeshValidationReport* report) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (report->non_finite_vertex_count > 0 || mesh.vertex_count() == 0) {
     report->signed_volume = report->surface_area = nan;
@@ -153,8 +158,10 @@ void MeasureGeometry(const TriangleMesh& mesh, const std::vector<char>& face_ok,
   report->min_edge_length = counted ? min_length : nan;
   report->max_edge_length = counted ? max_length : nan;
   report->mean_edge_length = counted ? sum_length / counted : nan;
-  const double area_floor = degenerate_area_tolerance * report->mean_edge_length * report->mean_edge_length;
-  for (int f = 0; f < mesh.face_count(); ++f) report->degenerate_face_count += face_ok[f] && areas[f] < area_floor;
+  const double area_floor =
+      degenerate_area_tolerance * report->mean_edge_length * report->mean_edge_length;
+  for (int f = 0; f < mesh.face_count(); ++f)
+    report->degenerate_face_count += face_ok[f] && areas[f] < area_floor;
   report->outward_oriented = report->closed && report->consistently_oriented && volume > 0.0;
 }
 
@@ -163,21 +170,28 @@ void CheckSelfIntersections(const TriangleMesh& mesh, const MeshValidationOption
   report->cgal.method = "CGAL";
   report->tetgen.method = "TetGen";
   const bool finite = report->non_finite_vertex_count == 0;
-  if (!options.check_self_intersections_cgal) report->cgal.note = "skipped (option)";
-  else if (!finite) report->cgal.note = "not run: non-finite coordinates";
+  if (!options.check_self_intersections_cgal)
+    report->cgal.note = "skipped (option)";
+  else if (!finite)
+    report->cgal.note = "not run: non-finite coordinates";
   else if (!report->manifold || !report->consistently_oriented)
     report->cgal.note = "not run: CGAL's halfedge mesh needs an oriented 2-manifold";
-  else report->cgal = FindSelfIntersectionsCgal(mesh, options.max_example_pairs);
+  else
+    report->cgal = FindSelfIntersectionsCgal(mesh, options.max_example_pairs);
 
-  if (!options.check_self_intersections_tetgen) report->tetgen.note = "skipped (option)";
-  else if (!finite) report->tetgen.note = "not run: non-finite coordinates";
-  else report->tetgen = FindSelfIntersectionsTetgen(mesh);
+  if (!options.check_self_intersections_tetgen)
+    report->tetgen.note = "skipped (option)";
+  else if (!finite)
+    report->tetgen.note = "not run: non-finite coordinates";
+  else
+    report->tetgen = FindSelfIntersectionsTetgen(mesh);
 
   report->self_intersection_checks_agree =
       report->cgal.ran && report->tetgen.ran && report->cgal.found() == report->tetgen.found();
-  report->self_intersecting_faces_agree = report->self_intersection_checks_agree &&
-                                          report->cgal.intersecting_faces == report->tetgen.intersecting_faces &&
-                                          report->cgal.reported_face_count == report->tetgen.reported_face_count;
+  report->self_intersecting_faces_agree =
+      report->self_intersection_checks_agree &&
+      report->cgal.intersecting_faces == report->tetgen.intersecting_faces &&
+      report->cgal.reported_face_count == report->tetgen.reported_face_count;
 }
 
 void Judge(const MeshValidationOptions& options, MeshValidationReport* r) {
@@ -185,36 +199,44 @@ void Judge(const MeshValidationOptions& options, MeshValidationReport* r) {
   auto& warnings = r->warnings;
   if (r->face_count == 0) problems.push_back("the mesh has no faces");
   if (r->non_finite_vertex_count > 0)
-    problems.push_back(fmt::format("{} vertices have NaN or infinite coordinates", r->non_finite_vertex_count));
+    problems.push_back(
+        fmt::format("vertices with NaN or infinite coordinates: {}", r->non_finite_vertex_count));
   if (r->repeated_vertex_face_count > 0)
-    problems.push_back(fmt::format("{} faces repeat a vertex", r->repeated_vertex_face_count));
+    problems.push_back(fmt::format("faces repeating a vertex: {}", r->repeated_vertex_face_count));
   if (r->non_manifold_edge_count > 0)
-    problems.push_back(fmt::format("{} edges border more than two faces (non-manifold)", r->non_manifold_edge_count));
+    problems.push_back(fmt::format("non-manifold edges (bordering more than two faces): {}",
+                                   r->non_manifold_edge_count));
   if (r->non_manifold_vertex_count > 0)
-    problems.push_back(fmt::format("{} vertices are non-manifold (their faces form several fans, e.g. a bowtie)",
-                                   r->non_manifold_vertex_count));
+    problems.push_back(
+        fmt::format("non-manifold vertices (their faces form several fans, e.g. a bowtie): {}",
+                    r->non_manifold_vertex_count));
   if (r->inconsistent_edge_count > 0)
-    problems.push_back(fmt::format("{} edges join faces of opposite orientation", r->inconsistent_edge_count));
+    problems.push_back(
+        fmt::format("edges joining faces of opposite orientation: {}", r->inconsistent_edge_count));
   if (r->closed && r->manifold && r->consistently_oriented && !(r->signed_volume > 0.0))
-    problems.push_back(fmt::format("the closed surface is oriented inward (signed volume {:.6g} ≤ 0)", r->signed_volume));
+    problems.push_back(fmt::format(
+        "the closed surface is oriented inward (signed volume {:.6g} ≤ 0)", r->signed_volume));
   if (r->manifold && r->consistently_oriented && !r->topology_message.empty())
     problems.push_back("MeshTopology rejects the mesh: " + r->topology_message);
   if (r->cgal.found())
-    problems.push_back(fmt::format("CGAL finds {} pairs of intersecting faces{}", r->cgal.pair_count,
-                                   r->cgal.example_pairs.empty() ? std::string()
-                                       : fmt::format(" (e.g. faces {} and {})", r->cgal.example_pairs[0].first,
-                                                     r->cgal.example_pairs[0].second)));
+    problems.push_back(
+        fmt::format("pairs of intersecting faces found by CGAL: {}{}", r->cgal.pair_count,
+                    r->cgal.example_pairs.empty()
+                        ? std::string()
+                        : fmt::format(" (e.g. faces {} and {})", r->cgal.example_pairs[0].first,
+                                      r->cgal.example_pairs[0].second)));
   if (r->tetgen.found())
-    problems.push_back(fmt::format("TetGen finds {} faces in self-intersections", r->tetgen.reported_face_count));
+    problems.push_back(
+        fmt::format("self-intersecting faces found by TetGen: {}", r->tetgen.reported_face_count));
 
   if (!r->closed && r->face_count > 0)
-    warnings.push_back(fmt::format("open surface: {} boundary edges in {} loops", r->boundary_edge_count,
-                                   r->boundary_loop_count));
+    warnings.push_back(fmt::format("open surface: boundary edges {}, boundary loops {}",
+                                   r->boundary_edge_count, r->boundary_loop_count));
   if (r->unreferenced_vertex_count > 0)
-    warnings.push_back(fmt::format("{} vertices are used by no face", r->unreferenced_vertex_count));
+    warnings.push_back(fmt::format("vertices used by no face: {}", r->unreferenced_vertex_count));
   if (r->degenerate_face_count > 0)
-    warnings.push_back(fmt::format("{} faces are degenerate (area < {:g} × mean edge length²)",
-                                   r->degenerate_face_count, options.degenerate_area_tolerance));
+    warnings.push_back(fmt::format("degenerate faces (area < {:g} × mean edge length²): {}",
+                                   options.degenerate_area_tolerance, r->degenerate_face_count));
   for (const SelfIntersectionResult* check : {&r->cgal, &r->tetgen}) {
     const bool requested = check == &r->cgal ? options.check_self_intersections_cgal
                                              : options.check_self_intersections_tetgen;
@@ -246,7 +268,8 @@ MeshValidationReport ValidateMesh(const TriangleMesh& mesh, const MeshValidation
                                   const std::string& source) {
   std::string why;
   if (!options.Validate(&why)) ThrowError(source, "validation options", why);
-  if (mesh.V.cols() != 3 || mesh.F.cols() != 3) ThrowError(source, "mesh", "expected #V×3 positions and #F×3 faces");
+  if (mesh.V.cols() != 3 || mesh.F.cols() != 3)
+    ThrowError(source, "mesh", "expected #V×3 positions and #F×3 faces");
   MeshValidationReport report;
   const int n = mesh.vertex_count();
   const int m = mesh.face_count();
@@ -257,8 +280,10 @@ MeshValidationReport ValidateMesh(const TriangleMesh& mesh, const MeshValidation
     for (int k = 0; k < 3; ++k)
       if (mesh.F(f, k) < 0 || mesh.F(f, k) >= n)
         ThrowError(source, "face " + std::to_string(f),
-                   "vertex index " + std::to_string(mesh.F(f, k)) + " out of range [0, " + std::to_string(n) + ")");
-    if (mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) || mesh.F(f, 0) == mesh.F(f, 2)) {
+                   "vertex index " + std::to_string(mesh.F(f, k)) + " out of range [0, " +
+                       std::to_string(n) + ")");
+    if (mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) ||
+        mesh.F(f, 0) == mesh.F(f, 2)) {
       face_ok[f] = 0;
       ++report.repeated_vertex_face_count;
     }

@@ -21,10 +21,9 @@
 //                 Open boundaries, degenerate faces and unreferenced vertices are warnings.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "geometry/self_intersections.h"
 #include "geometry/triangle_mesh.h"
@@ -50,26 +49,26 @@ struct MeshValidationReport {
   int face_count = 0;
   int edge_count = 0;
   int unreferenced_vertex_count = 0;
-  int non_finite_vertex_count = 0;      // vertices with a NaN or infinite coordinate
-  int repeated_vertex_face_count = 0;   // faces naming one vertex twice
+  int non_finite_vertex_count = 0;     // vertices with a NaN or infinite coordinate
+  int repeated_vertex_face_count = 0;  // faces naming one vertex twice
 
   // Topology.
   int boundary_edge_count = 0;
   int boundary_loop_count = 0;
   bool closed = false;
-  int non_manifold_edge_count = 0;      // edges with more than two faces
-  int non_manifold_vertex_count = 0;    // vertices whose faces form more than one fan
+  int non_manifold_edge_count = 0;    // edges with more than two faces
+  int non_manifold_vertex_count = 0;  // vertices whose faces form more than one fan
   bool manifold = false;
-  std::string topology_message;         // MeshTopology's error, empty when it accepts the mesh
-  int inconsistent_edge_count = 0;      // 2-face edges traversed twice in the same direction
+  std::string topology_message;     // MeshTopology's error, empty when it accepts the mesh
+  int inconsistent_edge_count = 0;  // 2-face edges traversed twice in the same direction
   bool consistently_oriented = false;
   int component_count = 0;
   int euler_characteristic = 0;
-  int genus = -1;                       // −1 when undefined (non-manifold or non-orientable)
+  int genus = -1;  // −1 when undefined (non-manifold or non-orientable)
 
   // Geometry (NaN when coordinates are not finite).
-  double signed_volume = 0.0;           // meaningful for closed meshes
-  bool outward_oriented = false;        // closed and signed_volume > 0
+  double signed_volume = 0.0;     // meaningful for closed meshes
+  bool outward_oriented = false;  // closed and signed_volume > 0
   double surface_area = 0.0;
   Eigen::Vector3d bbox_min = Eigen::Vector3d::Zero();
   Eigen::Vector3d bbox_max = Eigen::Vector3d::Zero();
@@ -81,8 +80,8 @@ struct MeshValidationReport {
   // Self-intersections (ran = false when skipped by the options or not applicable).
   SelfIntersectionResult cgal;
   SelfIntersectionResult tetgen;
-  bool self_intersection_checks_agree = false;   // both ran and reached the same verdict
-  bool self_intersecting_faces_agree = false;    // ... and found the same faces
+  bool self_intersection_checks_agree = false;  // both ran and reached the same verdict
+  bool self_intersecting_faces_agree = false;   // ... and found the same faces
 
   std::vector<std::string> problems;  // why the mesh is not valid; empty ⇔ valid
   std::vector<std::string> warnings;  // notable facts that do not invalidate the mesh
@@ -97,7 +96,8 @@ struct MeshValidationReport {
 // Measures `mesh` and judges it (see the definitions above). Throws subflow::Error
 // (naming `source`) only when a face index is out of range or the options are invalid;
 // every other defect is reported.
-MeshValidationReport ValidateMesh(const TriangleMesh& mesh, const MeshValidationOptions& options = {},
+MeshValidationReport ValidateMesh(const TriangleMesh& mesh,
+                                  const MeshValidationOptions& options = {},
                                   const std::string& source = "mesh");
 
 }  // namespace subflow::geometry

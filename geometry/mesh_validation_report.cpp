@@ -1,8 +1,8 @@
 // Presentation of a MeshValidationReport: text for people, JSON for tools.
-#include <cmath>
-
-#include <nlohmann/json.hpp>
 #include <spdlog/fmt/fmt.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "geometry/mesh_validation.h"
 
@@ -14,9 +14,12 @@ std::string YesNo(bool value) { return value ? "yes" : "no"; }
 std::string CheckLine(const SelfIntersectionResult& check) {
   if (!check.ran) return check.note.empty() ? "not run" : check.note;
   std::string line;
-  if (!check.found()) line = "none";
-  else if (check.pair_count >= 0) line = fmt::format("{} pairs over {} faces", check.pair_count, check.reported_face_count);
-  else line = fmt::format("{} faces", check.reported_face_count);
+  if (!check.found())
+    line = "none";
+  else if (check.pair_count >= 0)
+    line = fmt::format("{} pairs over {} faces", check.pair_count, check.reported_face_count);
+  else
+    line = fmt::format("{} faces", check.reported_face_count);
   if (!check.example_pairs.empty()) {
     line += " (e.g.";
     for (size_t i = 0; i < std::min<size_t>(check.example_pairs.size(), 3); ++i)
@@ -49,28 +52,37 @@ nlohmann::ordered_json CheckJson(const SelfIntersectionResult& check, int max_ex
 
 std::string MeshValidationReport::FullReport() const {
   std::string text;
-  text += fmt::format("elements:   {} vertices, {} faces, {} edges; {} unreferenced vertices\n", vertex_count,
-                      face_count, edge_count, unreferenced_vertex_count);
-  text += fmt::format("closed:     {} ({} boundary edges in {} loops)\n", YesNo(closed), boundary_edge_count,
-                      boundary_loop_count);
-  text += fmt::format("manifold:   {} ({} non-manifold edges, {} non-manifold vertices, {} faces repeating a vertex)\n",
-                      YesNo(manifold), non_manifold_edge_count, non_manifold_vertex_count, repeated_vertex_face_count);
+  text += fmt::format("elements:   {} vertices, {} faces, {} edges; {} unreferenced vertices\n",
+                      vertex_count, face_count, edge_count, unreferenced_vertex_count);
+  text += fmt::format("closed:     {} ({} boundary edges in {} loops)\n", YesNo(closed),
+                      boundary_edge_count, boundary_loop_count);
+  text += fmt::format(
+      "manifold:   {} ({} non-manifold edges, {} non-manifold vertices, {} faces repeating a "
+      "vertex)\n",
+      YesNo(manifold), non_manifold_edge_count, non_manifold_vertex_count,
+      repeated_vertex_face_count);
   text += fmt::format("oriented:   {} consistently ({} inconsistent edges); outward: {}\n",
                       consistently_oriented ? "yes," : "not", inconsistent_edge_count,
                       closed ? YesNo(outward_oriented) : "n/a (open)");
-  text += fmt::format("topology:   {} components, Euler characteristic {}, genus {}\n", component_count,
-                      euler_characteristic, genus >= 0 ? std::to_string(genus) : "undefined");
-  text += fmt::format("volume:     {:.9g} (signed{})\n", signed_volume, closed ? "" : "; not enclosed: open surface");
+  text +=
+      fmt::format("topology:   {} components, Euler characteristic {}, genus {}\n", component_count,
+                  euler_characteristic, genus >= 0 ? std::to_string(genus) : "undefined");
+  text += fmt::format("volume:     {:.9g} (signed{})\n", signed_volume,
+                      closed ? "" : "; not enclosed: open surface");
   text += fmt::format("area:       {:.9g}\n", surface_area);
-  text += fmt::format("bounds:     [{:.6g}, {:.6g}, {:.6g}] .. [{:.6g}, {:.6g}, {:.6g}]\n", bbox_min.x(), bbox_min.y(),
-                      bbox_min.z(), bbox_max.x(), bbox_max.y(), bbox_max.z());
-  text += fmt::format("edges:      length min {:.6g}, mean {:.6g}, max {:.6g}; {} degenerate faces\n", min_edge_length,
-                      mean_edge_length, max_edge_length, degenerate_face_count);
+  text += fmt::format("bounds:     [{:.6g}, {:.6g}, {:.6g}] .. [{:.6g}, {:.6g}, {:.6g}]\n",
+                      bbox_min.x(), bbox_min.y(), bbox_min.z(), bbox_max.x(), bbox_max.y(),
+                      bbox_max.z());
+  text +=
+      fmt::format("edges:      length min {:.6g}, mean {:.6g}, max {:.6g}; {} degenerate faces\n",
+                  min_edge_length, mean_edge_length, max_edge_length, degenerate_face_count);
   text += fmt::format("self-intersections (CGAL):   {}\n", CheckLine(cgal));
   text += fmt::format("self-intersections (TetGen): {}\n", CheckLine(tetgen));
   if (cgal.ran && tetgen.ran)
     text += fmt::format("checks agree: {}{}\n", YesNo(self_intersection_checks_agree),
-                        self_intersection_checks_agree && !self_intersecting_faces_agree ? " (different faces)" : "");
+                        self_intersection_checks_agree && !self_intersecting_faces_agree
+                            ? " (different faces)"
+                            : "");
   if (!topology_message.empty()) text += "MeshTopology: " + topology_message + "\n";
   for (const std::string& warning : warnings) text += "warning: " + warning + "\n";
   for (const std::string& problem : problems) text += "problem: " + problem + "\n";
@@ -103,16 +115,17 @@ std::string MeshValidationReport::ToJson(int indent) const {
                       {"euler_characteristic", euler_characteristic},
                       {"genus", genus >= 0 ? Json(genus) : Json(nullptr)},
                       {"mesh_topology_message", topology_message}};
-  json["geometry"] = {{"signed_volume", number(signed_volume)},
-                      {"outward_oriented", outward_oriented},
-                      {"surface_area", number(surface_area)},
-                      {"bbox_min", {number(bbox_min.x()), number(bbox_min.y()), number(bbox_min.z())}},
-                      {"bbox_max", {number(bbox_max.x()), number(bbox_max.y()), number(bbox_max.z())}},
-                      {"edge_length",
-                       {{"min", number(min_edge_length)},
-                        {"mean", number(mean_edge_length)},
-                        {"max", number(max_edge_length)}}},
-                      {"degenerate_faces", degenerate_face_count}};
+  json["geometry"] = {
+      {"signed_volume", number(signed_volume)},
+      {"outward_oriented", outward_oriented},
+      {"surface_area", number(surface_area)},
+      {"bbox_min", {number(bbox_min.x()), number(bbox_min.y()), number(bbox_min.z())}},
+      {"bbox_max", {number(bbox_max.x()), number(bbox_max.y()), number(bbox_max.z())}},
+      {"edge_length",
+       {{"min", number(min_edge_length)},
+        {"mean", number(mean_edge_length)},
+        {"max", number(max_edge_length)}}},
+      {"degenerate_faces", degenerate_face_count}};
   const int examples = 10;
   json["self_intersections"] = {{"cgal", CheckJson(cgal, examples)},
                                 {"tetgen", CheckJson(tetgen, examples)},

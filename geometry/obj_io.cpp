@@ -59,7 +59,8 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
     if (tokens[0] == "v") {
       const int vertex = static_cast<int>(positions.size() / 3);
       if (tokens.size() < 4)
-        ThrowError(source, where + " (vertex " + std::to_string(vertex) + ")", "expected \"v x y z\"");
+        ThrowError(source, where + " (vertex " + std::to_string(vertex) + ")",
+                   "expected \"v x y z\"");
       for (int axis = 0; axis < 3; ++axis) {
         double value = 0.0;
         if (!ParseDouble(tokens[1 + axis], &value))
@@ -67,8 +68,8 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
                      "\"" + std::string(tokens[1 + axis]) + "\" is not a number");
         if (!std::isfinite(value))
           ThrowError(source, where + " (vertex " + std::to_string(vertex) + ")",
-                     std::string("coordinate ") + "xyz"[axis] + " is " + (std::isnan(value) ? "NaN" : "infinite") +
-                         " (expected a finite number)");
+                     std::string("coordinate ") + "xyz"[axis] + " is " +
+                         (std::isnan(value) ? "NaN" : "infinite") + " (expected a finite number)");
         positions.push_back(value);
       }
     } else if (tokens[0] == "f") {
@@ -85,14 +86,16 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
         const auto result = std::from_chars(corner.data(), corner.data() + corner.size(), index);
         if (result.ec != std::errc() || result.ptr != corner.data() + corner.size() || index == 0)
           ThrowError(source, field,
-                     "\"" + std::string(tokens[k]) + "\" is not a vertex index (expected a non-zero integer)");
+                     "\"" + std::string(tokens[k]) +
+                         "\" is not a vertex index (expected a non-zero integer)");
         // Negative indices count back from the latest vertex; positive ones may only be
         // checked once every vertex has been read.
         const long long zero_based = index < 0 ? vertex_count + index : index - 1;
         if (zero_based < 0)
           ThrowError(source, field,
-                     "relative vertex index " + std::to_string(index) + " points before the first vertex (only " +
-                         std::to_string(vertex_count) + " vertices defined so far)");
+                     "relative vertex index " + std::to_string(index) +
+                         " points before the first vertex (only " + std::to_string(vertex_count) +
+                         " vertices defined so far)");
         if (zero_based > std::numeric_limits<int>::max())
           ThrowError(source, field, "vertex index " + std::to_string(index) + " out of range");
         corners.push_back(static_cast<int>(zero_based));
@@ -114,9 +117,10 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
     for (int k = 0; k < 3; ++k) {
       const int v = corners[3 * f + k];
       if (v >= n)
-        ThrowError(source, "line " + std::to_string(corner_lines[f]) + " (face " + std::to_string(f) + ")",
-                   "vertex index " + std::to_string(v + 1) + " out of range [1, " + std::to_string(n) +
-                       "] (1-based)");
+        ThrowError(source,
+                   "line " + std::to_string(corner_lines[f]) + " (face " + std::to_string(f) + ")",
+                   "vertex index " + std::to_string(v + 1) + " out of range [1, " +
+                       std::to_string(n) + "] (1-based)");
       mesh.F(f, k) = v;
     }
   return mesh;
@@ -127,12 +131,15 @@ void WriteObj(std::ostream& out, const TriangleMesh& mesh, const std::string& so
   char line[96];
   for (int v = 0; v < mesh.vertex_count(); ++v) {
     if (!mesh.V.row(v).allFinite())
-      ThrowError(source, "vertex " + std::to_string(v), "non-finite coordinate (refusing to write it)");
-    std::snprintf(line, sizeof(line), "v %.17g %.17g %.17g\n", mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2));
+      ThrowError(source, "vertex " + std::to_string(v),
+                 "non-finite coordinate (refusing to write it)");
+    std::snprintf(line, sizeof(line), "v %.17g %.17g %.17g\n", mesh.V(v, 0), mesh.V(v, 1),
+                  mesh.V(v, 2));
     text += line;
   }
   for (int f = 0; f < mesh.face_count(); ++f) {
-    std::snprintf(line, sizeof(line), "f %d %d %d\n", mesh.F(f, 0) + 1, mesh.F(f, 1) + 1, mesh.F(f, 2) + 1);
+    std::snprintf(line, sizeof(line), "f %d %d %d\n", mesh.F(f, 0) + 1, mesh.F(f, 1) + 1,
+                  mesh.F(f, 2) + 1);
     text += line;
   }
   out.write(text.data(), static_cast<std::streamsize>(text.size()));

@@ -1,17 +1,16 @@
+// Reading PLY (declared in geometry/ply_io.h).
 #include "geometry/ply_io.h"
+
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <set>
 #include <string_view>
-
-#include <spdlog/spdlog.h>
 
 #include "geometry/error.h"
 
@@ -25,21 +24,29 @@ struct ScalarTypeName {
   ScalarType type;
 };
 constexpr ScalarTypeName kScalarTypeNames[] = {
-    {"char", ScalarType::kInt8},       {"int8", ScalarType::kInt8},
-    {"uchar", ScalarType::kUint8},     {"uint8", ScalarType::kUint8},
-    {"short", ScalarType::kInt16},     {"int16", ScalarType::kInt16},
-    {"ushort", ScalarType::kUint16},   {"uint16", ScalarType::kUint16},
-    {"int", ScalarType::kInt32},       {"int32", ScalarType::kInt32},
-    {"uint", ScalarType::kUint32},     {"uint32", ScalarType::kUint32},
-    {"float", ScalarType::kFloat32},   {"float32", ScalarType::kFloat32},
-    {"double", ScalarType::kFloat64},  {"float64", ScalarType::kFloat64}};
+    {"char", ScalarType::kInt8},      {"int8", ScalarType::kInt8},
+    {"uchar", ScalarType::kUint8},    {"uint8", ScalarType::kUint8},
+    {"short", ScalarType::kInt16},    {"int16", ScalarType::kInt16},
+    {"ushort", ScalarType::kUint16},  {"uint16", ScalarType::kUint16},
+    {"int", ScalarType::kInt32},      {"int32", ScalarType::kInt32},
+    {"uint", ScalarType::kUint32},    {"uint32", ScalarType::kUint32},
+    {"float", ScalarType::kFloat32},  {"float32", ScalarType::kFloat32},
+    {"double", ScalarType::kFloat64}, {"float64", ScalarType::kFloat64}};
 
 int ScalarSize(ScalarType type) {
   switch (type) {
-    case ScalarType::kInt8: case ScalarType::kUint8: return 1;
-    case ScalarType::kInt16: case ScalarType::kUint16: return 2;
-    case ScalarType::kInt32: case ScalarType::kUint32: case ScalarType::kFloat32: return 4;
-    case ScalarType::kFloat64: return 8;
+    case ScalarType::kInt8:
+    case ScalarType::kUint8:
+      return 1;
+    case ScalarType::kInt16:
+    case ScalarType::kUint16:
+      return 2;
+    case ScalarType::kInt32:
+    case ScalarType::kUint32:
+    case ScalarType::kFloat32:
+      return 4;
+    case ScalarType::kFloat64:
+      return 8;
   }
   return 0;
 }
@@ -137,21 +144,28 @@ Header ParseHeader(const std::string& bytes, const std::string& source) {
     if (keyword == "end_header") break;
     if (keyword == "format") {
       if (tokens.size() != 3)
-        ThrowError(source, where, "expected \"format <ascii|binary_little_endian|binary_big_endian> 1.0\"");
-      if (tokens[1] == "ascii") header.encoding = Encoding::kAscii;
-      else if (tokens[1] == "binary_little_endian") header.encoding = Encoding::kBinaryLittleEndian;
-      else if (tokens[1] == "binary_big_endian") header.encoding = Encoding::kBinaryBigEndian;
+        ThrowError(source, where,
+                   "expected \"format <ascii|binary_little_endian|binary_big_endian> 1.0\"");
+      if (tokens[1] == "ascii")
+        header.encoding = Encoding::kAscii;
+      else if (tokens[1] == "binary_little_endian")
+        header.encoding = Encoding::kBinaryLittleEndian;
+      else if (tokens[1] == "binary_big_endian")
+        header.encoding = Encoding::kBinaryBigEndian;
       else
-        ThrowError(source, where, "unsupported format \"" + std::string(tokens[1]) +
-                                      "\" (expected ascii, binary_little_endian or binary_big_endian)");
+        ThrowError(source, where,
+                   "unsupported format \"" + std::string(tokens[1]) +
+                       "\" (expected ascii, binary_little_endian or binary_big_endian)");
       if (tokens[2] != "1.0")
-        ThrowError(source, where, "unsupported version \"" + std::string(tokens[2]) + "\" (expected 1.0)");
+        ThrowError(source, where,
+                   "unsupported version \"" + std::string(tokens[2]) + "\" (expected 1.0)");
       have_format = true;
     } else if (keyword == "element") {
       Element element;
       long long count = -1;
       if (tokens.size() == 3) {
-        const auto [end, ec] = std::from_chars(tokens[2].data(), tokens[2].data() + tokens[2].size(), count);
+        const auto [end, ec] =
+            std::from_chars(tokens[2].data(), tokens[2].data() + tokens[2].size(), count);
         if (ec != std::errc() || end != tokens[2].data() + tokens[2].size()) count = -1;
       }
       if (count < 0 || count > std::numeric_limits<int>::max())
@@ -167,19 +181,23 @@ Header ParseHeader(const std::string& bytes, const std::string& source) {
         ThrowError(source, where, "property declared before any element");
       Property property;
       if (tokens.size() == 3 && tokens[1] != "list") {
-        if (!ParseScalarType(tokens[1], &property.type)) ThrowError(source, where, ScalarTypeError(tokens[1]));
+        if (!ParseScalarType(tokens[1], &property.type))
+          ThrowError(source, where, ScalarTypeError(tokens[1]));
         property.name = std::string(tokens[2]);
       } else if (tokens.size() == 5 && tokens[1] == "list") {
         property.is_list = true;
         if (!ParseScalarType(tokens[2], &property.count_type))
           ThrowError(source, where, ScalarTypeError(tokens[2]));
         if (!IsInteger(property.count_type))
-          ThrowError(source, where, "list count type must be an integer type, not " + std::string(tokens[2]));
-        if (!ParseScalarType(tokens[3], &property.type)) ThrowError(source, where, ScalarTypeError(tokens[3]));
+          ThrowError(source, where,
+                     "list count type must be an integer type, not " + std::string(tokens[2]));
+        if (!ParseScalarType(tokens[3], &property.type))
+          ThrowError(source, where, ScalarTypeError(tokens[3]));
         property.name = std::string(tokens[4]);
       } else {
         ThrowError(source, where,
-                   "expected \"property <type> <name>\" or \"property list <count type> <item type> <name>\"");
+                   "expected \"property <type> <name>\" or \"property list <count type> <item "
+                   "type> <name>\"");
       }
       header.elements.back().properties.push_back(property);
     } else {
@@ -198,7 +216,10 @@ Header ParseHeader(const std::string& bytes, const std::string& source) {
 class AsciiBody {
  public:
   AsciiBody(const std::string& bytes, const Header& header, const std::string& source)
-      : bytes_(bytes), pos_(header.body_offset), line_number_(header.body_line - 1), source_(source) {}
+      : bytes_(bytes),
+        pos_(header.body_offset),
+        line_number_(header.body_line - 1),
+        source_(source) {}
 
   void Begin(const Element& element, long long index) {
     element_ = &element;
@@ -226,24 +247,27 @@ class AsciiBody {
       long long value = 0;
       const auto result = std::from_chars(token.data(), end, value);
       if (result.ec != std::errc() || result.ptr != end)
-        ThrowError(source_, Where(), "property \"" + property + "\": \"" + std::string(token) +
-                                         "\" is not an integer");
+        ThrowError(
+            source_, Where(),
+            "property \"" + property + "\": \"" + std::string(token) + "\" is not an integer");
       return static_cast<double>(value);
     }
     double value = 0.0;
     const auto result = std::from_chars(token.data(), end, value);
-    if (result.ec == std::errc::result_out_of_range) return std::copysign(HUGE_VAL, token[0] == '-' ? -1 : 1);
+    if (result.ec == std::errc::result_out_of_range)
+      return std::copysign(HUGE_VAL, token[0] == '-' ? -1 : 1);
     if (result.ec != std::errc() || result.ptr != end)
-      ThrowError(source_, Where(), "property \"" + property + "\": \"" + std::string(token) +
-                                       "\" is not a number");
+      ThrowError(source_, Where(),
+                 "property \"" + property + "\": \"" + std::string(token) + "\" is not a number");
     // A float property holds a float: round as a binary file would have stored it.
     return type == ScalarType::kFloat32 ? static_cast<double>(static_cast<float>(value)) : value;
   }
 
   void End() {
     if (next_token_ != tokens_.size())
-      ThrowError(source_, Where(), "the line has " + std::to_string(tokens_.size()) +
-                                       " values, more than the header's properties describe");
+      ThrowError(source_, Where(),
+                 "the line has " + std::to_string(tokens_.size()) +
+                     " values, more than the header's properties describe");
   }
 
   void Finish() {
@@ -251,13 +275,15 @@ class AsciiBody {
     while (NextLine(bytes_, &pos_, &line)) {
       ++line_number_;
       if (!Tokens(line).empty())
-        ThrowError(source_, "line " + std::to_string(line_number_),
-                   "data after the last element (the header's element counts do not match the data)");
+        ThrowError(
+            source_, "line " + std::to_string(line_number_),
+            "data after the last element (the header's element counts do not match the data)");
     }
   }
 
   std::string Where() const {
-    return element_->name + " " + std::to_string(index_) + " (line " + std::to_string(line_number_) + ")";
+    return element_->name + " " + std::to_string(index_) + " (line " +
+           std::to_string(line_number_) + ")";
   }
 
  private:
@@ -275,7 +301,9 @@ class AsciiBody {
 class BinaryBody {
  public:
   BinaryBody(const std::string& bytes, const Header& header, const std::string& source)
-      : bytes_(bytes), pos_(header.body_offset), source_(source),
+      : bytes_(bytes),
+        pos_(header.body_offset),
+        source_(source),
         swap_((header.encoding == Encoding::kBinaryBigEndian) != HostIsBigEndian()) {}
 
   void Begin(const Element& element, long long index) {
@@ -287,21 +315,30 @@ class BinaryBody {
     const int size = ScalarSize(type);
     if (pos_ + size > bytes_.size())
       ThrowError(source_, Where(),
-                 "truncated binary data: the file ends inside property \"" + property + "\" (the header announces " +
-                     std::to_string(element_->count) + " " + element_->name + " elements)");
+                 "truncated binary data: the file ends inside property \"" + property +
+                     "\" (the header announces " + std::to_string(element_->count) + " " +
+                     element_->name + " elements)");
     unsigned char raw[8];
     std::memcpy(raw, bytes_.data() + pos_, size);
     pos_ += size;
     if (swap_) std::reverse(raw, raw + size);
     switch (type) {
-      case ScalarType::kInt8: return Load<std::int8_t>(raw);
-      case ScalarType::kUint8: return Load<std::uint8_t>(raw);
-      case ScalarType::kInt16: return Load<std::int16_t>(raw);
-      case ScalarType::kUint16: return Load<std::uint16_t>(raw);
-      case ScalarType::kInt32: return Load<std::int32_t>(raw);
-      case ScalarType::kUint32: return Load<std::uint32_t>(raw);
-      case ScalarType::kFloat32: return Load<float>(raw);
-      case ScalarType::kFloat64: return Load<double>(raw);
+      case ScalarType::kInt8:
+        return Load<std::int8_t>(raw);
+      case ScalarType::kUint8:
+        return Load<std::uint8_t>(raw);
+      case ScalarType::kInt16:
+        return Load<std::int16_t>(raw);
+      case ScalarType::kUint16:
+        return Load<std::uint16_t>(raw);
+      case ScalarType::kInt32:
+        return Load<std::int32_t>(raw);
+      case ScalarType::kUint32:
+        return Load<std::uint32_t>(raw);
+      case ScalarType::kFloat32:
+        return Load<float>(raw);
+      case ScalarType::kFloat64:
+        return Load<double>(raw);
     }
     return 0.0;
   }
@@ -310,7 +347,8 @@ class BinaryBody {
 
   void Finish() {
     if (pos_ != bytes_.size())
-      spdlog::warn("{}: {} bytes after the last element are ignored", source_, bytes_.size() - pos_);
+      spdlog::warn("{}: {} bytes after the last element are ignored", source_,
+                   bytes_.size() - pos_);
   }
 
   std::string Where() const { return element_->name + " " + std::to_string(index_); }
@@ -348,15 +386,19 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
     if (element.name == "face") face = &element;
     // Every instance takes at least one byte, so a larger count cannot be honest; this
     // rejects truncated files before allocating what their header promises.
-    if (!element.properties.empty() && element.count > static_cast<long long>(bytes.size() - header.body_offset))
+    if (!element.properties.empty() &&
+        element.count > static_cast<long long>(bytes.size() - header.body_offset))
       ThrowError(source, "element " + element.name,
                  "the header announces " + std::to_string(element.count) + " elements but only " +
-                     std::to_string(bytes.size() - header.body_offset) + " bytes of data follow (truncated file)");
+                     std::to_string(bytes.size() - header.body_offset) +
+                     " bytes of data follow (truncated file)");
   }
   if (!vertex) ThrowError(source, "header", "no \"vertex\" element");
   if (!face) ThrowError(source, "header", "no \"face\" element (expected a triangle mesh)");
-  if (vertex->count == 0) ThrowError(source, "element vertex", "count is 0 (expected a non-empty mesh)");
-  if (face->count == 0) ThrowError(source, "element face", "count is 0 (expected a non-empty mesh)");
+  if (vertex->count == 0)
+    ThrowError(source, "element vertex", "count is 0 (expected a non-empty mesh)");
+  if (face->count == 0)
+    ThrowError(source, "element face", "count is 0 (expected a non-empty mesh)");
 
   // Roles of the vertex properties: coordinate axis, extra column, or skipped list.
   std::vector<int> vertex_role(vertex->properties.size(), -1);  // 0..2 axis, 3+k extra k, -1 skip
@@ -365,7 +407,8 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
   for (int axis = 0; axis < 3; ++axis) {
     const int p = FindProperty(*vertex, {kAxes[axis]});
     if (p < 0 || vertex->properties[p].is_list)
-      ThrowError(source, "element vertex", std::string("expected a scalar property \"") + kAxes[axis] + "\"");
+      ThrowError(source, "element vertex",
+                 std::string("expected a scalar property \"") + kAxes[axis] + "\"");
     vertex_role[p] = axis;
   }
   for (size_t p = 0; p < vertex->properties.size(); ++p)
@@ -393,13 +436,16 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
         if (!property.is_list) {
           const double value = body.Scalar(property.type, property.name);
           if (is_vertex && vertex_role[p] >= 0) {
-            if (vertex_role[p] < 3) mesh.V(i, vertex_role[p]) = value;
-            else extra(i, vertex_role[p] - 3) = value;
+            if (vertex_role[p] < 3)
+              mesh.V(i, vertex_role[p]) = value;
+            else
+              extra(i, vertex_role[p] - 3) = value;
           }
           continue;
         }
         const double length = body.Scalar(property.count_type, property.name + " (list length)");
-        if (length < 0) ThrowError(source, body.Where(), "negative list length in \"" + property.name + "\"");
+        if (length < 0)
+          ThrowError(source, body.Where(), "negative list length in \"" + property.name + "\"");
         if (is_face && static_cast<int>(p) == index_property) {
           if (length != 3)
             ThrowError(source, body.Where(),
@@ -414,7 +460,8 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
             mesh.F(i, k) = static_cast<int>(index);
           }
         } else {
-          for (long long k = 0; k < static_cast<long long>(length); ++k) body.Scalar(property.type, property.name);
+          for (long long k = 0; k < static_cast<long long>(length); ++k)
+            body.Scalar(property.type, property.name);
         }
       }
       body.End();
@@ -423,7 +470,8 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
           if (!std::isfinite(mesh.V(i, axis)))
             ThrowError(source, body.Where(),
                        std::string("coordinate ") + kAxes[axis] + " is " +
-                           (std::isnan(mesh.V(i, axis)) ? "NaN" : "infinite") + " (expected a finite number)");
+                           (std::isnan(mesh.V(i, axis)) ? "NaN" : "infinite") +
+                           " (expected a finite number)");
       }
     }
   }
@@ -432,28 +480,16 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
   if (properties) {
     properties->names = extra_names;
     properties->values.clear();
-    for (size_t k = 0; k < extra_names.size(); ++k) properties->values[extra_names[k]] = extra.col(k);
+    for (size_t k = 0; k < extra_names.size(); ++k)
+      properties->values[extra_names[k]] = extra.col(k);
   }
   return mesh;
 }
 
-void AppendFloat(std::string* buffer, float value, bool swap) {
-  unsigned char raw[4];
-  std::memcpy(raw, &value, 4);
-  if (swap) std::reverse(raw, raw + 4);
-  buffer->append(reinterpret_cast<const char*>(raw), 4);
-}
-
-void AppendInt32(std::string* buffer, std::int32_t value, bool swap) {
-  unsigned char raw[4];
-  std::memcpy(raw, &value, 4);
-  if (swap) std::reverse(raw, raw + 4);
-  buffer->append(reinterpret_cast<const char*>(raw), 4);
-}
-
 }  // namespace
 
-TriangleMesh ParsePly(const std::string& bytes, const std::string& source, VertexProperties* properties) {
+TriangleMesh ParsePly(const std::string& bytes, const std::string& source,
+                      VertexProperties* properties) {
   const Header header = ParseHeader(bytes, source);
   if (header.encoding == Encoding::kAscii) {
     AsciiBody body(bytes, header, source);
@@ -461,81 +497,6 @@ TriangleMesh ParsePly(const std::string& bytes, const std::string& source, Verte
   }
   BinaryBody body(bytes, header, source);
   return ReadBody(body, header, bytes, source, properties);
-}
-
-std::vector<std::string> PropertyWriteOrder(const VertexProperties& properties, int vertex_count,
-                                            const std::string& source) {
-  std::vector<std::string> names = properties.names;
-  if (names.empty())
-    for (const auto& entry : properties.values) names.push_back(entry.first);
-  std::set<std::string> seen;
-  for (const std::string& name : names) {
-    const std::string field = "vertex property \"" + name + "\"";
-    const auto it = properties.values.find(name);
-    if (it == properties.values.end()) ThrowError(source, field, "listed in names but has no values");
-    if (it->second.size() != vertex_count)
-      ThrowError(source, field, "has " + std::to_string(it->second.size()) + " values; expected one per vertex (" +
-                                    std::to_string(vertex_count) + ")");
-    if (name == "x" || name == "y" || name == "z") ThrowError(source, field, "collides with a coordinate");
-    if (name.empty() || name.find_first_of(" \t\r\n") != std::string::npos)
-      ThrowError(source, field, "expected a non-empty name without white space");
-    if (!seen.insert(name).second) ThrowError(source, field, "listed twice in names");
-  }
-  if (seen.size() != properties.values.size())
-    ThrowError(source, "vertex properties", "values are given for properties missing from names");
-  return names;
-}
-
-void WritePly(std::ostream& out, const TriangleMesh& mesh, const VertexProperties* properties,
-              PlyFormat format, const std::string& source) {
-  const int n = mesh.vertex_count();
-  const int m = mesh.face_count();
-  const std::vector<std::string> names =
-      properties ? PropertyWriteOrder(*properties, n, source) : std::vector<std::string>{};
-  std::vector<const Eigen::VectorXd*> columns;
-  for (const std::string& name : names) columns.push_back(&properties->values.at(name));
-  for (int v = 0; v < n; ++v)
-    if (!mesh.V.row(v).allFinite())
-      ThrowError(source, "vertex " + std::to_string(v), "non-finite coordinate (refusing to write it)");
-
-  std::string text = "ply\nformat ";
-  text += format == PlyFormat::kAscii ? "ascii 1.0\n" : "binary_little_endian 1.0\n";
-  text += "comment written by subflow\n";
-  text += "element vertex " + std::to_string(n) + "\n";
-  text += "property float x\nproperty float y\nproperty float z\n";
-  for (const std::string& name : names) text += "property float " + name + "\n";
-  text += "element face " + std::to_string(m) + "\n";
-  text += "property list uchar int vertex_indices\nend_header\n";
-
-  if (format == PlyFormat::kAscii) {
-    char number[32];
-    for (int v = 0; v < n; ++v) {
-      for (int axis = 0; axis < 3; ++axis) {
-        std::snprintf(number, sizeof(number), axis ? " %.9g" : "%.9g", static_cast<double>(static_cast<float>(mesh.V(v, axis))));
-        text += number;
-      }
-      for (const Eigen::VectorXd* column : columns) {
-        std::snprintf(number, sizeof(number), " %.9g", static_cast<double>(static_cast<float>((*column)(v))));
-        text += number;
-      }
-      text += '\n';
-    }
-    for (int f = 0; f < m; ++f)
-      text += "3 " + std::to_string(mesh.F(f, 0)) + " " + std::to_string(mesh.F(f, 1)) + " " +
-              std::to_string(mesh.F(f, 2)) + "\n";
-  } else {
-    const bool swap = HostIsBigEndian();
-    text.reserve(text.size() + static_cast<size_t>(n) * 4 * (3 + names.size()) + static_cast<size_t>(m) * 13);
-    for (int v = 0; v < n; ++v) {
-      for (int axis = 0; axis < 3; ++axis) AppendFloat(&text, static_cast<float>(mesh.V(v, axis)), swap);
-      for (const Eigen::VectorXd* column : columns) AppendFloat(&text, static_cast<float>((*column)(v)), swap);
-    }
-    for (int f = 0; f < m; ++f) {
-      text += static_cast<char>(3);
-      for (int k = 0; k < 3; ++k) AppendInt32(&text, mesh.F(f, k), swap);
-    }
-  }
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
 }
 
 }  // namespace subflow::geometry

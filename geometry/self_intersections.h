@@ -38,7 +38,8 @@ struct SelfIntersectionResult {
 // CGAL::Surface_mesh<Epick::Point_3> (exact predicates). The conversion needs an oriented
 // 2-manifold; for any other mesh ran = false. Degenerate faces are counted separately,
 // not as intersections. At most `max_example_pairs` pairs are kept in example_pairs.
-SelfIntersectionResult FindSelfIntersectionsCgal(const TriangleMesh& mesh, int max_example_pairs = 10);
+SelfIntersectionResult FindSelfIntersectionsCgal(const TriangleMesh& mesh,
+                                                 int max_example_pairs = 10);
 
 // TetGen's detection of intersecting facets (switches "pdQ": read the faces as a
 // piecewise linear complex, -d detect self-intersections, quiet). Works on any triangle

@@ -1,11 +1,11 @@
 // CGAL is confined to this file (heavy headers).
-#include <algorithm>
-#include <chrono>
-#include <iterator>
-
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
+
+#include <algorithm>
+#include <chrono>
+#include <iterator>
 
 #include "geometry/self_intersections.h"
 
@@ -46,7 +46,8 @@ SelfIntersectionResult FindSelfIntersectionsCgal(const TriangleMesh& mesh, int m
         return result;
       }
   for (int f = 0; f < mesh.face_count(); ++f)
-    if (mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) || mesh.F(f, 0) == mesh.F(f, 2)) {
+    if (mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) ||
+        mesh.F(f, 0) == mesh.F(f, 2)) {
       result.note = "not run: face " + std::to_string(f) + " repeats a vertex";
       return result;
     }
@@ -79,8 +80,9 @@ SelfIntersectionResult FindSelfIntersectionsCgal(const TriangleMesh& mesh, int m
     result.intersecting_faces.push_back(j);
   }
   std::sort(result.intersecting_faces.begin(), result.intersecting_faces.end());
-  result.intersecting_faces.erase(std::unique(result.intersecting_faces.begin(), result.intersecting_faces.end()),
-                                  result.intersecting_faces.end());
+  result.intersecting_faces.erase(
+      std::unique(result.intersecting_faces.begin(), result.intersecting_faces.end()),
+      result.intersecting_faces.end());
   result.reported_face_count = static_cast<int>(result.intersecting_faces.size());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

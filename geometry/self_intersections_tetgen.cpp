@@ -1,9 +1,9 @@
+#include <tetgen.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <map>
-
-#include <tetgen.h>
 
 #include "geometry/self_intersections.h"
 
@@ -60,7 +60,8 @@ SelfIntersectionResult FindSelfIntersectionsTetgen(const TriangleMesh& mesh) {
   if (flat) {
     const double lift = extent.maxCoeff() > 0.0 ? extent.maxCoeff() : 1.0;
     for (int axis = 0; axis < 3; ++axis)
-      in.pointlist[3 * n + axis] = extent(axis) > 0.0 ? 0.5 * (low(axis) + high(axis)) : low(axis) + lift;
+      in.pointlist[3 * n + axis] =
+          extent(axis) > 0.0 ? 0.5 * (low(axis) + high(axis)) : low(axis) + lift;
   }
   in.numberoffacets = static_cast<int>(input_faces.size());
   in.facetlist = new tetgenio::facet[input_faces.size()];
@@ -82,7 +83,8 @@ SelfIntersectionResult FindSelfIntersectionsTetgen(const TriangleMesh& mesh) {
     // TetGen's terminatetetgen codes: 1 out of memory, 2 internal error, 3 self-
     // intersection it could not resolve, 4 very small input feature, 10 bad input.
     result.note = "TetGen stopped with error code " + std::to_string(code);
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   }
 
@@ -95,12 +97,14 @@ SelfIntersectionResult FindSelfIntersectionsTetgen(const TriangleMesh& mesh) {
     std::map<std::array<double, 3>, int> by_position;
     for (int v = n - 1; v >= 0; --v) by_position[{mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)}] = v;
     for (int v = 0; v < out.numberofpoints; ++v) {
-      const auto it = by_position.find({out.pointlist[3 * v], out.pointlist[3 * v + 1], out.pointlist[3 * v + 2]});
+      const auto it = by_position.find(
+          {out.pointlist[3 * v], out.pointlist[3 * v + 1], out.pointlist[3 * v + 2]});
       if (it != by_position.end()) to_input_vertex[v] = it->second;
     }
   }
   std::map<Triple, std::vector<int>> faces_by_triple;
-  for (int f : input_faces) faces_by_triple[Sorted(mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2))].push_back(f);
+  for (int f : input_faces)
+    faces_by_triple[Sorted(mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2))].push_back(f);
   int unmatched = 0;
   for (int t = 0; t < out.numberoftrifaces; ++t) {
     int corner[3];
@@ -110,20 +114,24 @@ SelfIntersectionResult FindSelfIntersectionsTetgen(const TriangleMesh& mesh) {
       corner[k] = (v >= 0 && v < out.numberofpoints) ? to_input_vertex[v] : -1;
       ok &= corner[k] >= 0;
     }
-    const auto it = ok ? faces_by_triple.find(Sorted(corner[0], corner[1], corner[2])) : faces_by_triple.end();
+    const auto it =
+        ok ? faces_by_triple.find(Sorted(corner[0], corner[1], corner[2])) : faces_by_triple.end();
     if (it == faces_by_triple.end()) {
       ++unmatched;
       continue;
     }
-    result.intersecting_faces.insert(result.intersecting_faces.end(), it->second.begin(), it->second.end());
+    result.intersecting_faces.insert(result.intersecting_faces.end(), it->second.begin(),
+                                     it->second.end());
   }
   std::sort(result.intersecting_faces.begin(), result.intersecting_faces.end());
-  result.intersecting_faces.erase(std::unique(result.intersecting_faces.begin(), result.intersecting_faces.end()),
-                                  result.intersecting_faces.end());
+  result.intersecting_faces.erase(
+      std::unique(result.intersecting_faces.begin(), result.intersecting_faces.end()),
+      result.intersecting_faces.end());
   result.ran = true;
   result.reported_face_count = static_cast<int>(result.intersecting_faces.size()) + unmatched;
   if (unmatched > 0)
-    result.note = std::to_string(unmatched) + " intersecting faces reported by TetGen match no input face";
+    result.note =
+        std::to_string(unmatched) + " intersecting faces reported by TetGen match no input face";
   if (input_faces.size() != static_cast<size_t>(mesh.face_count()))
     result.note += std::string(result.note.empty() ? "" : "; ") +
                    std::to_string(mesh.face_count() - static_cast<int>(input_faces.size())) +

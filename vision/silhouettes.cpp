@@ -101,6 +101,8 @@ void SilhouetteOptions::Check() const {
              "a finite value (negative = automatic)", motion_threshold);
   CheckRange(motion_min_threshold >= 0 && std::isfinite(motion_min_threshold),
              "motion_min_threshold", "a non-negative value", motion_min_threshold);
+  CheckRange(background_open_radius >= 0 && background_open_radius <= 100, "background_open_radius",
+             "an integer in [0, 100] pixels", background_open_radius);
   CheckRange(close_radius >= 0 && close_radius <= 100, "close_radius",
              "an integer in [0, 100] pixels", close_radius);
   CheckRange(min_region_pixels >= 0, "min_region_pixels", "a non-negative integer",
@@ -194,17 +196,17 @@ double TriangleThreshold(const cv::Mat& values) {
 }
 
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options) {
+                             const SilhouetteOptions& options, int open_radius) {
   SUBFLOW_CHECK(measure.type() == CV_32FC1, "ThresholdAndClean expects CV_32FC1");
   Silhouette silhouette;
   silhouette.measure = measure;
   silhouette.threshold = threshold;
   cv::Mat mask = measure > threshold;  // CV_8U 0 / 255
-  if (options.close_radius > 0) {
-    const int size = 2 * options.close_radius + 1;
-    const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(size, size));
-    cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, disk);
-  }
+  auto disk = [](int radius) {
+    return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+  };
+  if (open_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_OPEN, disk(open_radius));
+  if (options.close_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, disk(options.close_radius));
   if (options.min_region_pixels > 1) RemoveSmallRegions(&mask, options.min_region_pixels);
   if (options.fill_holes) FillHoles(&mask);
   silhouette.mask = mask;
@@ -254,7 +256,7 @@ Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& backgro
                                  options.background_blur_sigma);
   const double threshold = AutomaticThreshold(measure, options.background_threshold, options.background_method,
                                               options.background_min_threshold);
-  Silhouette silhouette = ThresholdAndClean(measure, threshold, options);
+  Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius);
   silhouette.source = EvidenceSource::kBackground;
   return silhouette;
 }

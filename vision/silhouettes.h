@@ -6,7 +6,7 @@
 //                  d(p) = sqrt(Σ_c (I_c(p) − B_c(p))² / C) over the C colour channels of
 //                  intensities in [0, 1] (gray: |I − B|), slightly Gaussian-blurred,
 //                  thresholded (automatic: triangle or Otsu on d; or a fixed value), then
-//                  cleaned (2D closing, small regions removed, holes filled).
+//                  cleaned (2D opening, closing, small regions removed, holes filled).
 //  3. kMotion      motion evidence, method eq. 23, per pixel and frame g:
 //                      θ_g(p) = |∂I/∂t(p)| / (λ + ‖∇I(p)‖²)
 //                  with I the Gaussian-smoothed gray image (σ = motion_sigma), ∇I central
@@ -69,6 +69,11 @@ struct SilhouetteOptions {
   // peak of background noise plus a long tail of object pixels whose shaded parts come
   // close to the background; Otsu splits the object's bright and dark parts instead.
   ThresholdMethod background_method = ThresholdMethod::kTriangle;
+  // Radius (pixels) of a 2D opening of the thresholded difference, before the closing:
+  // removes specks of sensor noise above the threshold (which the closing would otherwise
+  // glue onto the object as spikes). Not applied to motion evidence, whose thresholded θ
+  // is made of thin texture edges. 0 = none.
+  int background_open_radius = 1;
   // Lower bound of the automatic threshold: differences below this are always noise
   // (0.02 ≈ 5 gray levels of an 8-bit image). Keeps the automatic threshold from
   // splitting pure noise when the object is absent.
@@ -156,11 +161,12 @@ cv::Mat MotionEvidence(const std::vector<cv::Mat>& gray_frames, int index,
 Silhouette SilhouetteFromMotion(const std::vector<cv::Mat>& gray_frames, int index,
                                 const SilhouetteOptions& options = {});
 
-// Thresholds a CV_32FC1 measure (v > threshold → object) and cleans the result as the
-// options say (closing, hole filling, small regions removed); fills every field of the
-// returned Silhouette except `source`.
+// Thresholds a CV_32FC1 measure (v > threshold → object) and cleans the result: opening
+// of radius open_radius, closing of radius options.close_radius (disks), regions under
+// options.min_region_pixels removed, holes filled (options.fill_holes); fills every
+// field of the returned Silhouette except `source`.
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options);
+                             const SilhouetteOptions& options, int open_radius = 0);
 
 // Silhouettes of every camera of `dataset` at `frame` (index = camera index), cameras in
 // parallel. Source per camera: options.source, or for kAuto masks if has_masks(), else

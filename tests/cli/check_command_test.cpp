@@ -1,14 +1,13 @@
 // `subflow check` end to end: exit status, one-line errors, JSON output.
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 namespace {
 
@@ -36,8 +35,8 @@ class CheckCommand : public ::testing::Test {
 
   CommandResult Subflow(const std::string& arguments) const {
     const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string command = std::string("'") + SUBFLOW_BINARY + "' " + arguments + " >'" + out.string() +
-                                "' 2>'" + err.string() + "'";
+    const std::string command = std::string("'") + SUBFLOW_BINARY + "' " + arguments + " >'" +
+                                out.string() + "' 2>'" + err.string() + "'";
     const int status = std::system(command.c_str());
     CommandResult run;
     run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -49,7 +48,8 @@ class CheckCommand : public ::testing::Test {
   fs::path dir_;
 };
 
-const std::string kBlobMesh = std::string(SUBFLOW_SHARED_DIR) + "/data/blob/groundtruth/mesh/000000.ply";
+const std::string kBlobMesh =
+    std::string(SUBFLOW_SHARED_DIR) + "/data/blob/groundtruth/mesh/000000.ply";
 
 TEST_F(CheckCommand, ValidMeshExitsZeroAndPrintsItsFigures) {
   const CommandResult run = Subflow("check '" + kBlobMesh + "'");
@@ -77,7 +77,9 @@ TEST_F(CheckCommand, InvalidOrUnreadableMeshExitsOneWithAOneLineError) {
   std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n";
   const CommandResult invalid = Subflow("check '" + bowtie.string() + "'");
   EXPECT_EQ(invalid.exit_code, 1);
-  EXPECT_EQ(invalid.err.rfind("subflow check: error: " + bowtie.string() + ": invalid mesh:", 0), 0u) << invalid.err;
+  EXPECT_EQ(invalid.err.rfind("subflow check: error: " + bowtie.string() + ": invalid mesh:", 0),
+            0u)
+      << invalid.err;
   EXPECT_NE(invalid.err.find("bowtie"), std::string::npos) << invalid.err;
   EXPECT_EQ(invalid.err.find('\n'), invalid.err.size() - 1) << "not one line: " << invalid.err;
 
@@ -85,7 +87,8 @@ TEST_F(CheckCommand, InvalidOrUnreadableMeshExitsOneWithAOneLineError) {
   std::ofstream(quad) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
   const CommandResult unreadable = Subflow("check '" + quad.string() + "'");
   EXPECT_EQ(unreadable.exit_code, 1);
-  EXPECT_NE(unreadable.err.find(quad.string() + ": line 5 (face 0): has 4 vertices"), std::string::npos)
+  EXPECT_NE(unreadable.err.find(quad.string() + ": line 5 (face 0): has 4 vertices"),
+            std::string::npos)
       << unreadable.err;
   EXPECT_TRUE(unreadable.out.empty()) << unreadable.out;
 

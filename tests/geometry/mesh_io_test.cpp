@@ -1,5 +1,6 @@
 #include "geometry/mesh_io.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,8 +13,6 @@
 #include <limits>
 #include <random>
 #include <sstream>
-
-#include <gtest/gtest.h>
 
 #include "geometry/error.h"
 
@@ -39,7 +38,8 @@ VertexProperties FlowProperties(int vertex_count) {
   VertexProperties properties;
   properties.names = {"vx", "vy", "vz", "confidence"};
   for (size_t k = 0; k < properties.names.size(); ++k)
-    properties.values[properties.names[k]] = Eigen::VectorXd::LinSpaced(vertex_count, 0.1 * k, 1.0 / 3.0 + k);
+    properties.values[properties.names[k]] =
+        Eigen::VectorXd::LinSpaced(vertex_count, 0.1 * k, 1.0 / 3.0 + k);
   return properties;
 }
 
@@ -80,7 +80,8 @@ class MeshIo : public ::testing::Test {
       const std::string message = e.what();
       EXPECT_NE(message.find(path), std::string::npos) << message;
       for (const std::string& fragment : fragments)
-        EXPECT_NE(message.find(fragment), std::string::npos) << "missing \"" << fragment << "\" in: " << message;
+        EXPECT_NE(message.find(fragment), std::string::npos)
+            << "missing \"" << fragment << "\" in: " << message;
     }
   }
 
@@ -89,16 +90,18 @@ class MeshIo : public ::testing::Test {
 
 // Binary and ASCII PLY store float, so a round trip must give back exactly the float
 // rounding of every coordinate and property (tolerance 0 on the float values).
-void ExpectFloatRoundTrip(const TriangleMesh& mesh, const VertexProperties& properties, const TriangleMesh& read,
-                          const VertexProperties& read_properties) {
+void ExpectFloatRoundTrip(const TriangleMesh& mesh, const VertexProperties& properties,
+                          const TriangleMesh& read, const VertexProperties& read_properties) {
   ASSERT_EQ(read.vertex_count(), mesh.vertex_count());
   ASSERT_EQ(read.face_count(), mesh.face_count());
-  for (int i = 0; i < mesh.V.size(); ++i) EXPECT_EQ(read.V.data()[i], AsFloat(mesh.V.data()[i])) << i;
+  for (int i = 0; i < mesh.V.size(); ++i)
+    EXPECT_EQ(read.V.data()[i], AsFloat(mesh.V.data()[i])) << i;
   EXPECT_EQ(read.F, mesh.F);
   EXPECT_EQ(read_properties.names, properties.names);
   for (const std::string& name : properties.names)
     for (int v = 0; v < mesh.vertex_count(); ++v)
-      EXPECT_EQ(read_properties.values.at(name)(v), AsFloat(properties.values.at(name)(v))) << name << " " << v;
+      EXPECT_EQ(read_properties.values.at(name)(v), AsFloat(properties.values.at(name)(v)))
+          << name << " " << v;
 }
 
 TEST_F(MeshIo, BinaryPlyRoundTripKeepsFloatValuesAndPropertiesExactly) {
@@ -150,7 +153,8 @@ TEST_F(MeshIo, BinaryOutputFollowsTheOutputContract) {
 }
 
 TEST_F(MeshIo, ReadsTheBlobGroundTruthMesh) {
-  const std::string path = std::string(SUBFLOW_SHARED_DIR) + "/data/blob/groundtruth/mesh/000000.ply";
+  const std::string path =
+      std::string(SUBFLOW_SHARED_DIR) + "/data/blob/groundtruth/mesh/000000.ply";
   const TriangleMesh mesh = ReadMesh(path);  // also checks manifoldness
   EXPECT_EQ(mesh.vertex_count(), 10242);
   EXPECT_EQ(mesh.face_count(), 20480);
@@ -171,7 +175,8 @@ void AppendBigEndian(std::string* bytes, T value) {
 TEST_F(MeshIo, ReadsBigEndianPlyWithMixedTypesAndSkipsOtherElements) {
   std::string bytes =
       "ply\nformat binary_big_endian 1.0\ncomment every scalar type once\n"
-      "element vertex 4\nproperty double x\nproperty float32 y\nproperty int16 z\nproperty uint8 red\n"
+      "element vertex 4\nproperty double x\nproperty float32 y\nproperty int16 z\nproperty uint8 "
+      "red\n"
       "property list uchar int8 tags\n"
       "element material 2\nproperty uint32 id\nproperty list ushort float64 values\n"
       "element face 4\nproperty uint8 flags\nproperty list uint16 uint32 vertex_index\n"
@@ -197,7 +202,8 @@ TEST_F(MeshIo, ReadsBigEndianPlyWithMixedTypesAndSkipsOtherElements) {
   for (const auto& face : faces) {
     AppendBigEndian<std::uint8_t>(&bytes, 1);
     AppendBigEndian<std::uint16_t>(&bytes, 3);
-    for (int k = 0; k < 3; ++k) AppendBigEndian<std::uint32_t>(&bytes, static_cast<std::uint32_t>(face[k]));
+    for (int k = 0; k < 3; ++k)
+      AppendBigEndian<std::uint32_t>(&bytes, static_cast<std::uint32_t>(face[k]));
     AppendBigEndian<std::int8_t>(&bytes, 2);
     AppendBigEndian<float>(&bytes, 0.25f);
     AppendBigEndian<float>(&bytes, 0.75f);
@@ -218,7 +224,8 @@ TEST_F(MeshIo, ReadsBigEndianPlyWithMixedTypesAndSkipsOtherElements) {
 TEST_F(MeshIo, ReadsAsciiPlyWithCrlfCommentsAndTrailingElements) {
   const std::string text =
       "ply\r\nformat ascii 1.0\r\ncomment made by hand\r\nobj_info nothing\r\n"
-      "element vertex 4\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nproperty uchar alpha\r\n"
+      "element vertex 4\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nproperty "
+      "uchar alpha\r\n"
       "element face 4\r\nproperty list int int vertex_indices\r\nproperty int label\r\n"
       "element edge 1\r\nproperty int vertex1\r\nproperty int vertex2\r\nend_header\r\n"
       "0 0 0 255\r\n1 0 0 255\r\n0 1 0 255\r\n0 0 +1e0 128\r\n"
@@ -246,36 +253,50 @@ TEST_F(MeshIo, ReadsObjCornerFormsNegativeIndicesAndIgnoresAttributes) {
 }
 
 const char* const kAsciiHeader =
-    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float "
+    "z\n"
     "element face 4\nproperty list uchar int vertex_indices\nend_header\n";
 const char* const kTetrahedronVertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
 
 TEST_F(MeshIo, BadPlyFilesNameTheFileTheElementAndTheExpectation) {
   const std::string header = kAsciiHeader, vertices = kTetrahedronVertices;
-  ExpectReadError(WriteFile("quad.ply", header + vertices + "4 0 1 2 3\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
-                  {"face 0", "has 4 vertices", "expected 3"});
-  ExpectReadError(WriteFile("nan.ply", header + "0 0 0\n1 nan 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
-                  {"vertex 1", "coordinate y is NaN", "expected a finite number"});
-  ExpectReadError(WriteFile("inf.ply", header + "0 0 0\n1 0 0\n0 1 -inf\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
-                  {"vertex 2", "infinite"});
-  ExpectReadError(WriteFile("range.ply", header + vertices + "3 0 2 1\n3 0 1 9\n3 1 2 3\n3 2 0 3\n"),
-                  {"face 1", "vertex index 9 out of range [0, 4)"});
+  ExpectReadError(
+      WriteFile("quad.ply", header + vertices + "4 0 1 2 3\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
+      {"face 0", "has 4 vertices", "expected 3"});
+  ExpectReadError(
+      WriteFile("nan.ply",
+                header + "0 0 0\n1 nan 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
+      {"vertex 1", "coordinate y is NaN", "expected a finite number"});
+  ExpectReadError(
+      WriteFile("inf.ply",
+                header + "0 0 0\n1 0 0\n0 1 -inf\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
+      {"vertex 2", "infinite"});
+  ExpectReadError(
+      WriteFile("range.ply", header + vertices + "3 0 2 1\n3 0 1 9\n3 1 2 3\n3 2 0 3\n"),
+      {"face 1", "vertex index 9 out of range [0, 4)"});
   ExpectReadError(WriteFile("short.ply", header + vertices + "3 0 2 1\n3 0 1 3\n"),
                   {"face 2", "ends after 2 of the 4 face lines"});
-  ExpectReadError(WriteFile("fewvalues.ply", header + "0 0 0\n1 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
-                  {"vertex 1 (line 11)", "before property \"z\""});
+  ExpectReadError(
+      WriteFile("fewvalues.ply",
+                header + "0 0 0\n1 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
+      {"vertex 1 (line 11)", "before property \"z\""});
   ExpectReadError(WriteFile("garbage.ply", "ply\nformat ascii 1.0\nhello world\nend_header\n"),
                   {"header line 3", "unexpected \"hello\""});
-  ExpectReadError(WriteFile("magic.ply", "solid cube\nfacet normal 0 0 1\n"), {"header line 1", "\"ply\""});
+  ExpectReadError(WriteFile("magic.ply", "solid cube\nfacet normal 0 0 1\n"),
+                  {"header line 1", "\"ply\""});
   ExpectReadError(WriteFile("format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"),
                   {"header line 2", "unsupported format \"binary_middle_endian\""});
-  ExpectReadError(WriteFile("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n"),
-                  {"header line 4", "unknown type \"float128\""});
-  ExpectReadError(WriteFile("nofaces.ply",
-                            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                            "property float z\nend_header\n0 0 0\n"),
-                  {"no \"face\" element"});
-  ExpectReadError(WriteFile("noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"), {"end_header"});
+  ExpectReadError(
+      WriteFile("type.ply",
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n"),
+      {"header line 4", "unknown type \"float128\""});
+  ExpectReadError(
+      WriteFile("nofaces.ply",
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                "property float z\nend_header\n0 0 0\n"),
+      {"no \"face\" element"});
+  ExpectReadError(WriteFile("noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"),
+                  {"end_header"});
   ExpectReadError(WriteFile("empty.ply", ""), {"empty"});
   ExpectReadError(Path("missing.ply"), {"no such file"});
   ExpectReadError(WriteFile("mesh.stl", "solid"), {"unsupported mesh file type \".stl\""});
@@ -303,7 +324,8 @@ TEST_F(MeshIo, BadObjFilesNameTheLineAndTheFace) {
                   {"line 5 (face 1)", "vertex index 7 out of range [1, 3]"});
   ExpectReadError(WriteFile("relative.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 1 1 0\n"),
                   {"line 3 (face 0)", "relative vertex index -3"});
-  ExpectReadError(WriteFile("zero.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 0 1 2\n"), {"line 4", "non-zero integer"});
+  ExpectReadError(WriteFile("zero.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 0 1 2\n"),
+                  {"line 4", "non-zero integer"});
   ExpectReadError(WriteFile("nan.obj", "v 0 0 0\nv 1 NaN 0\nv 1 1 0\nf 1 2 3\n"),
                   {"line 2 (vertex 1)", "coordinate y is NaN"});
   ExpectReadError(WriteFile("empty.obj", "# nothing\n"), {"no \"v\" statement"});
@@ -311,20 +333,27 @@ TEST_F(MeshIo, BadObjFilesNameTheLineAndTheFace) {
 
 TEST_F(MeshIo, NonManifoldInputIsRejectedUnlessAllowed) {
   const std::string header5 =
-      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n";
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float "
+      "z\n";
   const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n";
   // Fin: edge (0, 1) borders three faces.
-  const std::string fin = WriteFile("fin.ply", header5 + "element face 3\nproperty list uchar int vertex_indices\n"
-                                                         "end_header\n" + vertices + "3 0 1 2\n3 1 0 3\n3 1 0 4\n");
+  const std::string fin =
+      WriteFile("fin.ply", header5 +
+                               "element face 3\nproperty list uchar int vertex_indices\n"
+                               "end_header\n" +
+                               vertices + "3 0 1 2\n3 1 0 3\n3 1 0 4\n");
   ExpectReadError(fin, {"edge (1, 0)", "non-manifold"});
   MeshReadOptions lenient;
   lenient.require_manifold = false;
   EXPECT_EQ(ReadMesh(fin, lenient).face_count(), 3);
   // Bowtie: two triangles meeting only at vertex 0.
   const std::string bowtie_vertices = "0 0 0\n1 0 0\n1 1 0\n-1 0 0\n-1 -1 0\n";
-  ExpectReadError(WriteFile("bowtie.ply", header5 + "element face 2\nproperty list uchar int vertex_indices\n"
-                                                    "end_header\n" + bowtie_vertices + "3 0 1 2\n3 0 3 4\n"),
-                  {"vertex 0", "non-manifold vertex"});
+  ExpectReadError(
+      WriteFile("bowtie.ply", header5 +
+                                  "element face 2\nproperty list uchar int vertex_indices\n"
+                                  "end_header\n" +
+                                  bowtie_vertices + "3 0 1 2\n3 0 3 4\n"),
+      {"vertex 0", "non-manifold vertex"});
 }
 
 TEST_F(MeshIo, WritersRefuseMissingDirectoriesAndBadPropertiesAndLeaveNoTemporaryFile) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/LU>
 #include <gtest/gtest.h>
 
 #include "geometry/error.h"
@@ -123,7 +124,7 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
     const Eigen::Matrix3d A = Eigen::Matrix3d::Identity() - 0.5 * W;
     Positions next(scene.control.rows(), 3);
     for (Eigen::Index i = 0; i < next.rows(); ++i)
-      next.row(i) = A.solve((Eigen::Matrix3d::Identity() + 0.5 * W) * fitted.back().row(i).transpose() +
+      next.row(i) = A.partialPivLu().solve((Eigen::Matrix3d::Identity() + 0.5 * W) * fitted.back().row(i).transpose() +
                             truth.back().v).transpose();
     fitted.push_back(next);
   }
