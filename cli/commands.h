@@ -22,6 +22,7 @@ Command AddCheckCommand(CLI::App& app);  // cli/check_command.cpp
 Command AddSynthCommand(CLI::App& app);  // cli/synth_command.cpp
 Command AddEvalCommand(CLI::App& app);   // cli/eval_command.cpp
 Command AddSubdivideCommand(CLI::App& app);  // cli/subdivide_command.cpp
+Command AddHullCommand(CLI::App& app);       // cli/hull_command.cpp
 
 inline std::vector<AddCommandFunction> AllCommands() {
   return {
@@ -29,6 +30,7 @@ inline std::vector<AddCommandFunction> AllCommands() {
       AddSynthCommand,
       AddEvalCommand,
       AddSubdivideCommand,
+      AddHullCommand,
   };
 }
 

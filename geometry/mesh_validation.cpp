@@ -1,13 +1,13 @@
 #include "geometry/mesh_validation.h"
 
-#include <spdlog/fmt/fmt.h>
-
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numeric>
+
+#include <Eigen/Geometry>
+#include <spdlog/fmt/fmt.h>
 
 #include "geometry/error.h"
 #include "geometry/mesh_topology.h"

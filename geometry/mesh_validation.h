@@ -21,9 +21,10 @@
 //                 Open boundaries, degenerate faces and unreferenced vertices are warnings.
 #pragma once
 
-#include <Eigen/Core>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "geometry/self_intersections.h"
 #include "geometry/triangle_mesh.h"

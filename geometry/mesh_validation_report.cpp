@@ -1,8 +1,8 @@
 // Presentation of a MeshValidationReport: text for people, JSON for tools.
-#include <spdlog/fmt/fmt.h>
-
 #include <cmath>
+
 #include <nlohmann/json.hpp>
+#include <spdlog/fmt/fmt.h>
 
 #include "geometry/mesh_validation.h"
 

@@ -1,8 +1,6 @@
 // Reading PLY (declared in geometry/ply_io.h).
 #include "geometry/ply_io.h"
 
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -11,6 +9,8 @@
 #include <cstring>
 #include <limits>
 #include <string_view>
+
+#include <spdlog/spdlog.h>
 
 #include "geometry/error.h"
 

@@ -1,4 +1,6 @@
 // Writing PLY (declared in geometry/ply_io.h).
+#include "geometry/ply_io.h"
+
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -6,7 +8,6 @@
 #include <set>
 
 #include "geometry/error.h"
-#include "geometry/ply_io.h"
 
 namespace subflow::geometry {
 namespace {

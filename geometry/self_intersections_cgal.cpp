@@ -1,11 +1,11 @@
 // CGAL is confined to this file (heavy headers).
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Surface_mesh.h>
-
 #include <algorithm>
 #include <chrono>
 #include <iterator>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
 
 #include "geometry/self_intersections.h"
 

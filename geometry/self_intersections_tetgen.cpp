@@ -1,9 +1,9 @@
-#include <tetgen.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <map>
+
+#include <tetgen.h>
 
 #include "geometry/self_intersections.h"
 

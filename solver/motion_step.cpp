@@ -93,7 +93,7 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
           cameras_, smoothed_before, smoothed_after, positions, Positions(), visibility);
       step.report.photometric_rms_zero = Rms(zero.photometric);
     }
-    step.solution = solver_.Solve(constraints, pass > 0 ? &step.solution : nullptr);
+    step.solution = solver_.Solve(constraints, control, pass > 0 ? &step.solution : nullptr);
     step.displacement = step.solution.displacement;
     sample_motion = solver_.SampleMotion(step.displacement);
     step.report.cg_iterations += step.solution.cg_iterations;

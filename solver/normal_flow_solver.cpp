@@ -221,8 +221,22 @@ Eigen::VectorXd NormalFlowSolver::CollinearityWeights(const NormalFlowConstraint
   return weights;
 }
 
+std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
+                                                  const Positions& previous) const {
+  std::vector<Positions> rigid_part(n_ + 1);
+  if (!options_.rigid_invariant_smoothness || previous.rows() != control.rows()) return rigid_part;
+  Positions midpoints = control + 0.5 * previous;
+  const RigidMotion rigid = FitRigidMotion(midpoints, previous);
+  for (int level = n_; level >= lo_; --level) {
+    if (level <= hi_) rigid_part[level] = rigid.Velocity(midpoints);
+    if (level > lo_) midpoints = hierarchy_->Coarsening(level) * midpoints;
+  }
+  return rigid_part;
+}
+
 void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
                                    const Eigen::VectorXd& weights,
+                                   const std::vector<Positions>& rigid_part,
                                    NormalFlowSolution* solution) const {
   const int samples = static_cast<int>(limit_.rows());
   const int vertices = static_cast<int>(limit_.cols());
@@ -301,7 +315,9 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       report.smoothness_weight =
           options_.smoothness * report.data_stiffness * length_ratio4_[level];
       const double damping = (level == lo_ ? 1e-9 : options_.detail_damping) * report.data_stiffness;
-      const ConstVectorMap W(coarse_motion.data(), unknowns);
+      Positions smooth_about = coarse_motion;  // W_i − ρ_i
+      if (rigid_part[level].rows() == smooth_about.rows()) smooth_about -= rigid_part[level];
+      const ConstVectorMap W(smooth_about.data(), unknowns);
       const Eigen::VectorXd rhs =
           P3.transpose() * (q - N * D) - report.smoothness_weight * (smoothness3_[level] * W);
       A += report.smoothness_weight * smoothness3_[level];
@@ -330,8 +346,13 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
 }
 
 NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constraints,
+                                           const Positions& control,
                                            const NormalFlowSolution* warm_start) const {
   const int samples = static_cast<int>(limit_.rows());
+  if (control.rows() != limit_.cols())
+    ThrowError("normal flow solver", "control points",
+               std::to_string(control.rows()) + " rows, expected #V(n) = " +
+                   std::to_string(limit_.cols()));
   for (int c = 0; c < constraints.size(); ++c)
     if (constraints.sample[c] < 0 || constraints.sample[c] >= samples)
       ThrowError("normal flow solver", "constraint " + std::to_string(c),
@@ -341,8 +362,10 @@ NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constrai
   solution.collinearity_weights = CollinearityWeights(constraints, &solution.collinearity_pruned);
   Eigen::VectorXd weights = solution.collinearity_weights;
   Eigen::VectorXd residual;
+  Positions previous = warm_start ? warm_start->displacement : Positions();
   for (int pass = 0; pass <= options_.reweighting_iterations; ++pass) {
-    SolveLevels(constraints, weights, &solution);
+    SolveLevels(constraints, weights, RigidPart(control, previous), &solution);
+    previous = solution.displacement;
     residual = constraints.Residuals(SampleMotion(solution.displacement));
     if (pass == options_.reweighting_iterations) break;
     std::vector<double> active;
@@ -356,6 +379,7 @@ NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constrai
                    Tukey(residual(c) / (options_.robust_threshold * sigma));
   }
   solution.weights = weights;
+  solution.rigid = FitRigidMotion(control + 0.5 * solution.displacement, solution.displacement);
   double sum_zero = 0.0, sum = 0.0;
   int kept = 0;
   for (int c = 0; c < constraints.size(); ++c) {

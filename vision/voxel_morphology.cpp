@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include <Eigen/Core>
 #include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -189,28 +190,38 @@ ComponentSummary KeepLargeComponents(BinaryVolume* volume, double min_fraction, 
 
 size_t FillCavities(BinaryVolume* volume, int connectivity) {
   SUBFLOW_CHECK(connectivity == 6 || connectivity == 26, "connectivity must be 6 or 26");
-  const Padded padded(*volume);
-  // 0: occupied; 1: empty, not (yet) reached from the border; 2: frame, or empty and
-  // reached. The frame is marked reached up front and never walked (its own neighbours
-  // would fall outside the array); the flood starts from every empty border voxel.
-  std::vector<int> labels(padded.size(), 2);
-  for (int k = 0; k < volume->nz; ++k)
-    for (int j = 0; j < volume->ny; ++j)
-      for (int i = 0; i < volume->nx; ++i) labels[padded.Index(i, j, k)] = volume->at(i, j, k) ? 0 : 1;
-  const std::vector<ptrdiff_t> offsets = padded.Neighbours(connectivity == 26 ? 6 : 26);
-  std::vector<size_t> stack;
-  for (int k = 0; k < volume->nz; ++k)
-    for (int j = 0; j < volume->ny; ++j)
-      for (int i = 0; i < volume->nx; ++i) {
-        const bool border = i == 0 || j == 0 || k == 0 || i == volume->nx - 1 || j == volume->ny - 1 ||
-                            k == volume->nz - 1;
-        const size_t v = padded.Index(i, j, k);
-        if (border && labels[v] == 1) Flood(&labels, offsets, v, 1, 2, &stack);
-      }
-  size_t filled = 0;
+  // Only the bounding box of the occupied voxels grown by one voxel (clipped to the volume)
+  // can hold a cavity; its boundary layer is empty (or the volume's border), and every
+  // path from inside the box to the volume's border crosses that layer, so flooding from
+  // the layer's empty voxels within the box finds exactly the border-connected ones.
+  Eigen::Array3i lo(volume->nx, volume->ny, volume->nz), hi(-1, -1, -1);
   for (int k = 0; k < volume->nz; ++k)
     for (int j = 0; j < volume->ny; ++j)
       for (int i = 0; i < volume->nx; ++i)
+        if (volume->at(i, j, k)) lo = lo.min(Eigen::Array3i(i, j, k)), hi = hi.max(Eigen::Array3i(i, j, k));
+  if ((hi < 0).any()) return 0;  // nothing occupied
+  lo = (lo - 1).max(0);
+  hi = (hi + 1).min(Eigen::Array3i(volume->nx, volume->ny, volume->nz) - 1);
+  const Padded padded(*volume);
+  // 0: occupied; 1: empty, not (yet) reached from the border; 2: reached, or outside the
+  // box (the frame of the padded array included, so the flood never leaves the array).
+  std::vector<int> labels(padded.size(), 2);
+  for (int k = lo.z(); k <= hi.z(); ++k)
+    for (int j = lo.y(); j <= hi.y(); ++j)
+      for (int i = lo.x(); i <= hi.x(); ++i) labels[padded.Index(i, j, k)] = volume->at(i, j, k) ? 0 : 1;
+  const std::vector<ptrdiff_t> offsets = padded.Neighbours(connectivity == 26 ? 6 : 26);
+  std::vector<size_t> stack;
+  for (int k = lo.z(); k <= hi.z(); ++k)
+    for (int j = lo.y(); j <= hi.y(); ++j)
+      for (int i = lo.x(); i <= hi.x(); ++i) {
+        const bool layer = i == lo.x() || j == lo.y() || k == lo.z() || i == hi.x() || j == hi.y() || k == hi.z();
+        const size_t v = padded.Index(i, j, k);
+        if (layer && labels[v] == 1) Flood(&labels, offsets, v, 1, 2, &stack);
+      }
+  size_t filled = 0;
+  for (int k = lo.z(); k <= hi.z(); ++k)
+    for (int j = lo.y(); j <= hi.y(); ++j)
+      for (int i = lo.x(); i <= hi.x(); ++i)
         if (labels[padded.Index(i, j, k)] == 1) {
           volume->at(i, j, k) = 1;
           ++filled;

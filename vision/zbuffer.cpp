@@ -83,9 +83,12 @@ class TriangleRasterizer {
     // Edge k is opposite vertex k: E_k = 2 area · (screen barycentric of vertex k).
     const Edge edges[3] = {Edge(b.pixel, c.pixel), Edge(c.pixel, a.pixel), Edge(a.pixel, b.pixel)};
     const double twice_area = std::abs(area);
-    const bool identity_weights = a.weights == Eigen::Vector3d::UnitX() &&
-                                  b.weights == Eigen::Vector3d::UnitY() &&
-                                  c.weights == Eigen::Vector3d::UnitZ();
+    // Unclipped triangles (corner weights = unit vectors): (u, v) are the weights of the
+    // vertices that came in second and third.
+    const bool corner_weights = a.weights == Eigen::Vector3d::UnitX() &&
+                                b_in.weights == Eigen::Vector3d::UnitY() &&
+                                c_in.weights == Eigen::Vector3d::UnitZ();
+    const bool swapped = area < 0.0;
     for (int y = y0; y <= y1; ++y) {
       const double row[3] = {edges[0].B * y + edges[0].C, edges[1].B * y + edges[1].C,
                              edges[2].B * y + edges[2].C};
@@ -108,9 +111,9 @@ class TriangleRasterizer {
         zbuffer_.depth_[index] = static_cast<float>(depth);
         zbuffer_.face_[index] = face;
         const double inverse_s = 1.0 / s;
-        if (identity_weights) {
-          zbuffer_.barycentric_[2 * index] = static_cast<float>(w1 * inverse_s);
-          zbuffer_.barycentric_[2 * index + 1] = static_cast<float>(w2 * inverse_s);
+        if (corner_weights) {
+          zbuffer_.barycentric_[2 * index] = static_cast<float>((swapped ? w2 : w1) * inverse_s);
+          zbuffer_.barycentric_[2 * index + 1] = static_cast<float>((swapped ? w1 : w2) * inverse_s);
         } else {
           const Eigen::Vector3d weights = (w0 * a.weights + w1 * b.weights + w2 * c.weights) * inverse_s;
           zbuffer_.barycentric_[2 * index] = static_cast<float>(weights.y());

@@ -2,6 +2,7 @@
 // limit positions), bad input gives a one-line error and exit status 1.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>

@@ -173,10 +173,18 @@ TriangleMesh Fan(int faces) {
 // valence 3, 4, 5, 8; boundary vertices with 1, 2, 3, 4 and 6 faces. The limit masks of a
 // vertex only read its 1-ring, which refinement maps onto itself, so a fan around the
 // vertex is as good a test as any larger mesh.
+//
+// Only what the tests read is kept (the 8-level hierarchies are large and dropped):
+// level-0 operators, and the level-8 quantities at the base vertices (their indices are
+// kept by refinement).
 struct LimitCase {
   TriangleMesh base;
-  LoopHierarchy hierarchy;
-  Positions refined;  // control points after kRefinements refinements
+  LoopHierarchy coarse;          // level 0 only: the masks applied to the base mesh
+  Positions refined;             // base vertices' control points after 8 refinements
+  Positions fine_limit;          // LimitPositions(8) × c_8 at the base vertices
+  Positions fine_tangents[2];    // LimitTangent(8, which) × c_8 at the base vertices
+  Positions fine_normals;        // LimitNormals at level 8, at the base vertices
+  Positions ring_normals;        // area-weighted normals of their faces at level 8
 };
 
 const std::vector<LimitCase>& LimitCases() {
@@ -187,9 +195,25 @@ const std::vector<LimitCase>& LimitCases() {
                                    Perturbed(HalfFan(6), 0.2, 27)};
     std::vector<LimitCase> built;
     for (const TriangleMesh& mesh : meshes) {
-      LoopHierarchy hierarchy(mesh.F, mesh.vertex_count(), kRefinements);
-      Positions refined = hierarchy.Refine(mesh.V, 0, kRefinements);
-      built.push_back({mesh, std::move(hierarchy), std::move(refined)});
+      const int n = mesh.vertex_count();
+      const LoopHierarchy hierarchy(mesh.F, n, kRefinements);
+      const Positions refined = hierarchy.Refine(mesh.V, 0, kRefinements);
+      const MeshTopology& fine = hierarchy.Topology(kRefinements);
+      const Faces& F = hierarchy.LevelFaces(kRefinements);
+      Positions ring_normals = Positions::Zero(n, 3);
+      for (int v = 0; v < n; ++v) {
+        for (int f : fine.RingFaces(v)) {
+          const Eigen::Vector3d a = refined.row(F(f, 0)), b = refined.row(F(f, 1)),
+                                c = refined.row(F(f, 2));
+          ring_normals.row(v) += (b - a).cross(c - a).transpose();
+        }
+      }
+      built.push_back(
+          {mesh, LoopHierarchy(mesh.F, n, 0), refined.topRows(n),
+           (hierarchy.LimitPositions(kRefinements) * refined).topRows(n),
+           {(hierarchy.LimitTangent(kRefinements, 0) * refined).topRows(n),
+            (hierarchy.LimitTangent(kRefinements, 1) * refined).topRows(n)},
+           LimitNormals(hierarchy, kRefinements, refined).topRows(n), ring_normals});
     }
     return built;
   }();
@@ -203,9 +227,11 @@ const std::vector<LimitCase>& LimitCases() {
 // (1e-12 for O(1) coordinates), a tight check of the limit mask — an error δ in s shows
 // up as (1 − r^8) δ ≈ δ.
 TEST(LoopHierarchy, LimitPositionsAreWhereRepeatedRefinementConverges) {
-  for (const auto& [base, hierarchy, refined] : LimitCases()) {
-    const Positions limit = hierarchy.LimitPositions(0) * base.V;
-    const MeshTopology& topology = hierarchy.Topology(0);
+  for (const LimitCase& limit_case : LimitCases()) {
+    const TriangleMesh& base = limit_case.base;
+    const Positions& refined = limit_case.refined;
+    const Positions limit = limit_case.coarse.LimitPositions(0) * base.V;
+    const MeshTopology& topology = limit_case.coarse.Topology(0);
     for (int v = 0; v < base.vertex_count(); ++v) {
       const double c = 3.0 + 2.0 * std::cos(2.0 * M_PI / topology.Valence(v));
       const double rate = topology.IsBoundaryVertex(v) ? 0.25 : c * c / 64.0;
@@ -216,8 +242,7 @@ TEST(LoopHierarchy, LimitPositionsAreWhereRepeatedRefinementConverges) {
           << (topology.IsBoundaryVertex(v) ? " (boundary)" : "");
     }
     // The limit mask must give the same point whichever level it is applied on.
-    const Positions limit_fine = hierarchy.LimitPositions(kRefinements) * refined;
-    EXPECT_LT((limit_fine.topRows(base.vertex_count()) - limit).norm(), 1e-12);
+    EXPECT_LT((limit_case.fine_limit - limit).norm(), 1e-12);
   }
 }
 
@@ -226,12 +251,12 @@ TEST(LoopHierarchy, LimitPositionsAreWhereRepeatedRefinementConverges) {
 // 3/8 + cos(π/k)/4 (k ≥ 2). Hence the normal of the refined control points at level 8 is
 // exactly the normal at level 0 (rounding: 1e-12 relative to |λ^m T c|).
 TEST(LoopHierarchy, LimitTangentsAreEigenvectorsOfRefinement) {
-  for (const auto& [base, hierarchy, refined] : LimitCases()) {
-    const MeshTopology& topology = hierarchy.Topology(0);
+  for (const LimitCase& limit_case : LimitCases()) {
+    const TriangleMesh& base = limit_case.base;
+    const MeshTopology& topology = limit_case.coarse.Topology(0);
     for (int which = 0; which < 2; ++which) {
-      const Positions coarse_tangent = hierarchy.LimitTangent(0, which) * base.V;
-      const Positions fine_tangent =
-          (hierarchy.LimitTangent(kRefinements, which) * refined).topRows(base.vertex_count());
+      const Positions coarse_tangent = limit_case.coarse.LimitTangent(0, which) * base.V;
+      const Positions& fine_tangent = limit_case.fine_tangents[which];
       for (int v = 0; v < base.vertex_count(); ++v) {
         const int valence = topology.Valence(v);
         double eigenvalue = 0.375 + 0.25 * std::cos(2.0 * M_PI / valence);
@@ -245,9 +270,8 @@ TEST(LoopHierarchy, LimitTangentsAreEigenvectorsOfRefinement) {
             << (topology.IsBoundaryVertex(v) ? " (boundary)" : "");
       }
     }
-    const Positions coarse_normals = LimitNormals(hierarchy, 0, base.V);
-    const Positions fine_normals = LimitNormals(hierarchy, kRefinements, refined);
-    EXPECT_LT((fine_normals.topRows(base.vertex_count()) - coarse_normals).norm(), 1e-9);
+    const Positions coarse_normals = LimitNormals(limit_case.coarse, 0, base.V);
+    EXPECT_LT((limit_case.fine_normals - coarse_normals).norm(), 1e-9);
   }
 }
 
@@ -260,19 +284,13 @@ TEST(LoopHierarchy, LimitTangentsAreEigenvectorsOfRefinement) {
 // itself: after 8 levels 2e-8 for K = 4, 2e-7 for K = 5, 2e-3 for K = 8; K = 3 has only
 // the modes 1 and 2 = K − 1, so its ring normal is exact (1e-10 for rounding).
 TEST(LoopHierarchy, LimitNormalsMatchTheRefinedMeshAtInteriorVertices) {
-  for (const auto& [base, hierarchy, refined] : LimitCases()) {
-    const Positions normals = LimitNormals(hierarchy, 0, base.V);
-    const MeshTopology& fine = hierarchy.Topology(kRefinements);
-    const Faces& F = hierarchy.LevelFaces(kRefinements);
-    for (int v = 0; v < base.vertex_count(); ++v) {
-      if (fine.IsBoundaryVertex(v)) continue;
-      Eigen::Vector3d area_normal = Eigen::Vector3d::Zero();
-      for (int f : fine.RingFaces(v)) {
-        const Eigen::Vector3d a = refined.row(F(f, 0)), b = refined.row(F(f, 1)),
-                              c = refined.row(F(f, 2));
-        area_normal += (b - a).cross(c - a);
-      }
-      const int valence = fine.Valence(v);
+  for (const LimitCase& limit_case : LimitCases()) {
+    const Positions normals = LimitNormals(limit_case.coarse, 0, limit_case.base.V);
+    const MeshTopology& topology = limit_case.coarse.Topology(0);
+    for (int v = 0; v < limit_case.base.vertex_count(); ++v) {
+      if (topology.IsBoundaryVertex(v)) continue;
+      const Eigen::Vector3d area_normal = limit_case.ring_normals.row(v).transpose();
+      const int valence = topology.Valence(v);
       const double mu1 = 0.375 + 0.25 * std::cos(2.0 * M_PI / valence);
       const double mu2 = 0.375 + 0.25 * std::cos(4.0 * M_PI / valence);
       const double bound =

@@ -1,6 +1,5 @@
 #include "geometry/mesh_io.h"
 
-#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +12,8 @@
 #include <limits>
 #include <random>
 #include <sstream>
+
+#include <gtest/gtest.h>
 
 #include "geometry/error.h"
 

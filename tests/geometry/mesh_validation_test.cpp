@@ -1,10 +1,10 @@
 #include "geometry/mesh_validation.h"
 
-#include <gtest/gtest.h>
-
 #include <cmath>
-#include <nlohmann/json.hpp>
 #include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "geometry/error.h"
 #include "geometry/mesh_io.h"

@@ -247,7 +247,7 @@ TEST(NormalFlowSolver, RecoversAKnownMotionFromExactConstraints) {
   const SyntheticConstraints synthetic = MakeSyntheticConstraints(scene, samples, 7);
   NormalFlowSolverOptions options;
   const NormalFlowSolver solver(scene.hierarchy, samples.limit, scene.control, options);
-  const NormalFlowSolution solution = solver.Solve(synthetic.constraints);
+  const NormalFlowSolution solution = solver.Solve(synthetic.constraints, scene.control);
   const double error = RelativeError(solution.displacement, synthetic.true_displacement);
   std::printf("exact constraints: relative error %.2e, %d CG iterations, %d pruned of %d\n",
               error, solution.cg_iterations, solution.pruned, synthetic.constraints.size());
@@ -282,12 +282,12 @@ TEST(NormalFlowSolver, PruningRemovesInjectedBadMeasurements) {
       bad.push_back(i);
     }
   const NormalFlowSolution robust =
-      NormalFlowSolver(scene.hierarchy, samples.limit, scene.control, {}).Solve(c);
+      NormalFlowSolver(scene.hierarchy, samples.limit, scene.control, {}).Solve(c, scene.control);
   NormalFlowSolverOptions plain_options;
   plain_options.reweighting_iterations = 0;
   plain_options.collinearity_pruning = false;
   const NormalFlowSolution plain =
-      NormalFlowSolver(scene.hierarchy, samples.limit, scene.control, plain_options).Solve(c);
+      NormalFlowSolver(scene.hierarchy, samples.limit, scene.control, plain_options).Solve(c, scene.control);
   int bad_removed = 0;
   for (int i : bad) bad_removed += robust.weights(i) == 0.0;
   const double robust_error = RelativeError(robust.displacement, synthetic.true_displacement);

@@ -1,0 +1,22 @@
+// report.json sections shared by the subcommands: what was run (dataset, options,
+// versions) and the figures of each stage.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "solver/shape_init.h"
+#include "vision/dataset.h"
+
+namespace subflow::cli {
+
+// {"subflow_version", "libraries": {...}}.
+nlohmann::json VersionsJson();
+// {"directory", "cameras", "frames", "bounds", "has_masks", ...}.
+nlohmann::json DatasetJson(const vision::Dataset& dataset);
+// The options of shape initialization, field by field.
+nlohmann::json ShapeInitOptionsJson(const solver::ShapeInitOptions& options);
+// Options, base mesh, hierarchy and per-frame figures of shape initialization.
+nlohmann::json ShapeInitReport(const vision::Dataset& dataset, const solver::ShapeInitOptions& options,
+                               const solver::ShapeInitResult& result);
+
+}  // namespace subflow::cli

@@ -1,0 +1,70 @@
+#include "solver/result_writer.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include "geometry/error.h"
+#include "geometry/mesh_io.h"
+#include "vision/dataset.h"
+
+namespace subflow::solver {
+
+namespace fs = std::filesystem;
+
+void PrepareOutputDirectory(const std::string& directory, bool overwrite) {
+  std::error_code error;
+  if (fs::exists(directory, error)) {
+    if (!fs::is_directory(directory, error))
+      ThrowError(directory, "", "exists and is not a directory");
+    if (!fs::is_empty(directory, error) && !overwrite)
+      ThrowError(directory, "",
+                 "output directory exists and is not empty; choose another or pass --overwrite");
+    return;
+  }
+  fs::create_directories(directory, error);
+  if (error) ThrowError(directory, "", "cannot create the output directory: " + error.message());
+}
+
+void WriteResultMeshes(const std::string& directory, int first_frame, const geometry::Faces& faces,
+                       const std::vector<geometry::Positions>& positions,
+                       const std::map<std::string, std::vector<Eigen::VectorXd>>& per_frame_properties) {
+  const fs::path meshes = fs::path(directory) / "meshes";
+  std::error_code error;
+  fs::create_directories(meshes, error);
+  if (error) ThrowError(meshes.string(), "", "cannot create the directory: " + error.message());
+  const int frame_count = static_cast<int>(positions.size());
+  for (int i = 0; i < frame_count; ++i) {
+    const geometry::Positions& V = positions[i];
+    if (V.rows() != positions.front().rows())
+      ThrowError(meshes.string(), "frame " + std::to_string(first_frame + i),
+                 "expected the same vertex count at every frame");
+    const geometry::Positions motion =
+        i + 1 < frame_count ? geometry::Positions(positions[i + 1] - V)
+                            : geometry::Positions(geometry::Positions::Zero(V.rows(), 3));
+    geometry::VertexProperties properties;
+    properties.names = {"vx", "vy", "vz"};
+    for (int axis = 0; axis < 3; ++axis)
+      properties.values[properties.names[axis]] = motion.col(axis);
+    for (const auto& [name, values] : per_frame_properties) {
+      properties.names.push_back(name);
+      properties.values[name] = values.at(i);
+    }
+    geometry::WriteMesh((meshes / (vision::FrameName(first_frame + i) + ".ply")).string(),
+                        geometry::TriangleMesh{V, faces}, &properties);
+  }
+}
+
+void WriteJsonFile(const std::string& path, const nlohmann::json& json) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream stream(temporary);
+    if (!stream) ThrowError(path, "", "cannot open for writing");
+    stream << json.dump(2) << "\n";
+    if (!stream) ThrowError(path, "", "write failed");
+  }
+  std::error_code error;
+  fs::rename(temporary, path, error);
+  if (error) ThrowError(path, "", "cannot rename the temporary file: " + error.message());
+}
+
+}  // namespace subflow::solver

@@ -1,0 +1,36 @@
+// Writing results in the layout of ../shared/OUTPUT.md:
+//   <out>/meshes/<frame>.ply   binary little-endian PLY, float x y z, float vx vy vz (motion
+//                              to the next frame, zero at the last), same vertex order and
+//                              faces at every frame, extra float vertex properties after.
+//   <out>/report.json          written by the caller (see WriteJsonFile).
+// Nothing the user had is overwritten: PrepareOutputDirectory refuses a non-empty
+// directory unless asked to overwrite, and every file is written to a temporary name and
+// renamed.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "geometry/triangle_mesh.h"
+
+namespace subflow::solver {
+
+// Creates `directory` (and its parents). Throws subflow::Error naming it when it exists
+// and is not empty and `overwrite` is false, or when it cannot be created.
+void PrepareOutputDirectory(const std::string& directory, bool overwrite);
+
+// Writes <directory>/meshes/<frame>.ply for frames first_frame + i, i = 0..#positions − 1.
+// positions[i] is the tessellation's #V×3 vertices at that frame (all the same #V), faces
+// shared. per_frame_properties (optional) adds float vertex properties: name → one #V
+// vector per frame.
+void WriteResultMeshes(const std::string& directory, int first_frame, const geometry::Faces& faces,
+                       const std::vector<geometry::Positions>& positions,
+                       const std::map<std::string, std::vector<Eigen::VectorXd>>& per_frame_properties = {});
+
+// Writes `json` pretty-printed to `path` (through "<path>.tmp" and a rename).
+void WriteJsonFile(const std::string& path, const nlohmann::json& json);
+
+}  // namespace subflow::solver
