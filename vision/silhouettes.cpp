@@ -77,6 +77,10 @@ std::string ToString(EvidenceSource source) {
   return "?";
 }
 
+std::string ToString(ThresholdMethod method) {
+  return method == ThresholdMethod::kOtsu ? "otsu" : "triangle";
+}
+
 EvidenceSource ParseEvidenceSource(const std::string& text, const std::string& field) {
   for (EvidenceSource source : {EvidenceSource::kAuto, EvidenceSource::kMask,
                                 EvidenceSource::kBackground, EvidenceSource::kMotion})

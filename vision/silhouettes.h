@@ -14,9 +14,16 @@
 //                  time over frames g−1, g+1 (one-sided at the first and last frame;
 //                  intensity / frame). A point that does not move between one pair of
 //                  frames gives no evidence there, so θ is accumulated (maximum) over the
-//                  window g ∈ [f − w, f + w]; then thresholded (Otsu or fixed) and cleaned
-//                  as above: the thresholded θ marks moving texture and contours, the
-//                  cleaning turns that into a filled silhouette.
+//                  window g ∈ [f − w, f + w]; then thresholded (automatic: Otsu or
+//                  triangle; or a fixed value) and cleaned as above (no opening): the
+//                  thresholded θ marks moving texture and contours, the cleaning turns
+//                  that into a filled silhouette.
+//
+// Every source ends as a silhouette (evidence 0 / 1), which voxel carving integrates over
+// each voxel's footprint (vision/voxel_carving.h). For motion this departs slightly from
+// the paper, which integrates θ itself and thresholds per voxel: thresholding θ in the
+// image first lets one automatic threshold per image serve all voxels and lets the 2D
+// cleaning fill the flat, texture-less parts of the object, where θ is 0.
 //
 // Conventions: images are in RAW image coordinates (as stored, lens distortion not
 // removed); pixel (0, 0) is the centre of the top-left pixel (DATASET.md). Whoever
@@ -52,6 +59,8 @@ enum class ThresholdMethod {
   kOtsu,      // two classes of maximal between-class variance: for two well-separated modes
   kTriangle,  // the foot of the dominant (background) peak: for a peak plus a long tail
 };
+// "otsu", "triangle".
+std::string ToString(ThresholdMethod method);
 
 struct SilhouetteOptions {
   // Which evidence to use. kAuto takes, per camera, the first of mask / background /
@@ -59,8 +68,8 @@ struct SilhouetteOptions {
   EvidenceSource source = EvidenceSource::kAuto;
 
   // --- background difference ---
-  // σ (pixels) of the Gaussian blur of the difference image (suppresses pixel noise and
-  // half-pixel edge effects). 0 = no blur.
+  // σ (pixels) of the Gaussian blur of the difference image: suppresses pixel noise, but
+  // widens the silhouette by up to a pixel at the low automatic threshold. 0 = no blur.
   double background_blur_sigma = 0.5;
   // Threshold on the blurred difference (intensity units, [0, 1]); < 0 = automatic
   // (background_method on the difference image, never below background_min_threshold).
@@ -91,6 +100,9 @@ struct SilhouetteOptions {
   // Threshold on the accumulated θ; < 0 = automatic (motion_method, never below
   // motion_min_threshold).
   double motion_threshold = -1.0;
+  // Automatic method for θ. Otsu: θ of moving texture and contours forms a mode of its
+  // own above the static background's θ ≈ 0 (on ../shared/data/blob the cleaned motion
+  // silhouettes match the masks with mean IoU 0.93 with Otsu, 0.91 with triangle).
   ThresholdMethod motion_method = ThresholdMethod::kOtsu;
   // Lower bound of the automatic motion threshold (θ units). A static scene gives θ = 0
   // up to image noise; θ below this is no motion.

@@ -273,13 +273,14 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
     if (options.fill_cavities) result.cavity_voxels_filled = FillCavities(&occupied, options.connectivity);
     occupied.CopyTo(&occupancy);
     if (options.compute_silhouette_iou) {
+      const std::vector<Eigen::Vector3i> surface = SurfaceVoxels(occupancy);
       tbb::parallel_for(size_t(0), used.size(), [&](size_t u) {
         const int c = used[u].index;
         const cv::Mat mask = silhouettes[c].mask.type() == CV_8UC1 &&
                                      silhouettes[c].mask.size() == silhouettes[c].evidence.size()
                                  ? silhouettes[c].mask
                                  : cv::Mat(silhouettes[c].evidence >= 0.5f);
-        result.cameras[c].silhouette_iou = SilhouetteIoU(ProjectOccupancy(cameras[c], occupancy), mask);
+        result.cameras[c].silhouette_iou = SilhouetteIoU(ProjectVoxels(cameras[c], occupancy, surface), mask);
       });
     }
   });

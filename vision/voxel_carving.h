@@ -96,7 +96,7 @@ struct VoxelCarvingOptions {
   // Fill interior cavities (empty regions not connected to the volume's border).
   bool fill_cavities = true;
   // Compute CameraCarvingReport::silhouette_iou (projects the surface voxels of the
-  // result into every used camera; costs about as much as the carving).
+  // result into every used camera; about +15 % time at 128³ on the blob dataset).
   bool compute_silhouette_iou = true;
   // Worker threads (TBB); 0 = all available, 1 = serial (e.g. for a benchmark baseline).
   int threads = 0;
@@ -111,8 +111,10 @@ struct CameraCarvingReport {
   bool used = false;       // took part in the carving
   std::string excluded;    // why not, "" when used
   int object_pixels = 0;   // pixels of the silhouette
-  // |projection of the occupancy ∩ silhouette| / |… ∪ …| over the image (used cameras;
-  // NaN when not computed).
+  // |P ∩ S| / |P ∪ S| over the image, P = the projection of the occupied voxels' cubes
+  // (ProjectOccupancy), S = this camera's silhouette; NaN for unused cameras or when not
+  // computed. The cubes' staircase reaches a little beyond the iso-surface at ½, and the
+  // conservative hull beyond the silhouette cones, so expect ≈ 0.9 rather than 1.
   double silhouette_iou = std::numeric_limits<double>::quiet_NaN();
 };
 
@@ -132,9 +134,10 @@ struct CarvingResult {
   std::vector<std::string> warnings;
 };
 
-// The voxel count along the longest axis chosen by options.resolution / automatic rule:
+// The voxel count along the longest axis: options.resolution when > 0, else automatic:
 // spacing = pixels_per_voxel / max_k (f_k / depth_k(centre)) over the cameras that see
-// the volume's centre (f_k = (fx + fy) / 2); without any, the cap. Result in [8, cap].
+// the volume's centre (f_k = (fx + fy) / 2), clamped to [8, max_auto_resolution]; the
+// cap when no camera sees the centre.
 int ChooseResolution(const std::vector<Camera>& cameras, const Bounds& bounds,
                      const VoxelCarvingOptions& options);
 

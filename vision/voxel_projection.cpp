@@ -142,27 +142,49 @@ double SilhouetteIoU(const cv::Mat& a, const cv::Mat& b) {
   return either == 0 ? 1.0 : static_cast<double>(both) / either;
 }
 
-cv::Mat ProjectOccupancy(const Camera& camera, const ScalarVolume& occupancy) {
-  cv::Mat image = cv::Mat::zeros(camera.height(), camera.width(), CV_8UC1);
-  const VoxelCornerProjector projector(camera, occupancy);
+std::vector<Eigen::Vector3i> SurfaceVoxels(const ScalarVolume& occupancy) {
   auto occupied = [&](int i, int j, int k) {
     return occupancy.InRange(i, j, k) && occupancy.at(i, j, k) > 0.5f;
   };
-  Eigen::Vector2f corners[8], hull[16];
+  std::vector<Eigen::Vector3i> surface;
   for (int k = 0; k < occupancy.nz; ++k)
     for (int j = 0; j < occupancy.ny; ++j)
-      for (int i = 0; i < occupancy.nx; ++i) {
-        if (!occupied(i, j, k)) continue;
-        if (occupied(i - 1, j, k) && occupied(i + 1, j, k) && occupied(i, j - 1, k) &&
-            occupied(i, j + 1, k) && occupied(i, j, k - 1) && occupied(i, j, k + 1))
-          continue;  // interior: its projection is covered by the surface voxels'
-        bool valid = true;
-        for (int c = 0; c < 8 && valid; ++c)
-          valid = projector.ProjectCorner(i + (c & 1), j + ((c >> 1) & 1), k + (c >> 2), &corners[c].x(),
-                                          &corners[c].y());
-        if (valid) FillConvex(hull, ConvexHull(corners, hull), &image);
-      }
+      for (int i = 0; i < occupancy.nx; ++i)
+        if (occupied(i, j, k) &&
+            !(occupied(i - 1, j, k) && occupied(i + 1, j, k) && occupied(i, j - 1, k) && occupied(i, j + 1, k) &&
+              occupied(i, j, k - 1) && occupied(i, j, k + 1)))
+          surface.emplace_back(i, j, k);
+  return surface;
+}
+
+cv::Mat ProjectVoxels(const Camera& camera, const ScalarVolume& grid, const std::vector<Eigen::Vector3i>& voxels) {
+  cv::Mat image = cv::Mat::zeros(camera.height(), camera.width(), CV_8UC1);
+  const VoxelCornerProjector projector(camera, grid);
+  Eigen::Vector2f corners[8], hull[16];
+  for (const Eigen::Vector3i& voxel : voxels) {
+    bool valid = true;
+    for (int c = 0; c < 8 && valid; ++c)
+      valid = projector.ProjectCorner(voxel.x() + (c & 1), voxel.y() + ((c >> 1) & 1), voxel.z() + (c >> 2),
+                                      &corners[c].x(), &corners[c].y());
+    if (!valid) continue;
+    // Most surface voxels project inside what is already drawn: skip those whose
+    // bounding box has every pixel centre set.
+    Eigen::Vector2f lo = corners[0], hi = corners[0];
+    for (int c = 1; c < 8; ++c) lo = lo.cwiseMin(corners[c]), hi = hi.cwiseMax(corners[c]);
+    const int x0 = std::max(0, static_cast<int>(std::ceil(lo.x()))), x1 = std::min(image.cols - 1, static_cast<int>(std::floor(hi.x())));
+    const int y0 = std::max(0, static_cast<int>(std::ceil(lo.y()))), y1 = std::min(image.rows - 1, static_cast<int>(std::floor(hi.y())));
+    bool covered = x0 <= x1 && y0 <= y1;
+    for (int y = y0; y <= y1 && covered; ++y) {
+      const uint8_t* row = image.ptr<uint8_t>(y);
+      for (int x = x0; x <= x1 && covered; ++x) covered = row[x] != 0;
+    }
+    if (!covered) FillConvex(hull, ConvexHull(corners, hull), &image);
+  }
   return image;
+}
+
+cv::Mat ProjectOccupancy(const Camera& camera, const ScalarVolume& occupancy) {
+  return ProjectVoxels(camera, occupancy, SurfaceVoxels(occupancy));
 }
 
 }  // namespace subflow::vision

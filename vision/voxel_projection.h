@@ -10,6 +10,8 @@
 // the centre of the top-left pixel, because silhouettes are in raw image coordinates.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
@@ -56,6 +58,13 @@ bool ProjectsIntoImage(const Camera& camera, const Eigen::Vector3d& X);
 // centres it contains; only voxels with an empty face-neighbour are drawn (they bound the
 // projection). Voxels with a corner that cannot be projected are skipped.
 cv::Mat ProjectOccupancy(const Camera& camera, const geometry::ScalarVolume& occupancy);
+
+// The occupied voxels (> 0.5) with an empty (or outside) face-neighbour, in index order.
+std::vector<Eigen::Vector3i> SurfaceVoxels(const geometry::ScalarVolume& occupancy);
+// ProjectOccupancy for a precomputed list of voxels of `grid` (e.g. SurfaceVoxels, shared
+// by several cameras).
+cv::Mat ProjectVoxels(const Camera& camera, const geometry::ScalarVolume& grid,
+                      const std::vector<Eigen::Vector3i>& voxels);
 
 // |a ∩ b| / |a ∪ b| of two CV_8UC1 images of one size (non-zero = in); 1 when both are empty.
 double SilhouetteIoU(const cv::Mat& a, const cv::Mat& b);

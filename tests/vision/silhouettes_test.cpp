@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -63,6 +64,23 @@ TEST(Silhouettes, OtsuSeparatesTwoLevels) {
   EXPECT_GT(t, 0.1 + 0.06);
   EXPECT_LT(t, 0.7 - 0.06);
   EXPECT_FLOAT_EQ(OtsuThreshold(cv::Mat(5, 5, CV_32F, cv::Scalar(0.3))), 0.3f);  // constant image
+}
+
+// A background-difference-like histogram: 80 % noise |N(0, 0.01)|, 20 % object spread
+// uniformly over [0.05, 0.6]. The triangle threshold sits at the foot of the noise peak
+// (≈ 3σ of the noise = 0.03, below the object's lowest 0.05); Otsu splits the object.
+TEST(Silhouettes, TriangleFindsTheFootOfTheNoisePeakWhereOtsuSplitsTheObject) {
+  cv::Mat values(100, 100, CV_32F);
+  cv::RNG rng(9);
+  for (int y = 0; y < 100; ++y)
+    for (int x = 0; x < 100; ++x)
+      values.at<float>(y, x) = y < 80 ? std::abs(static_cast<float>(rng.gaussian(0.01)))
+                                      : static_cast<float>(rng.uniform(0.05, 0.6));
+  const double triangle = TriangleThreshold(values);
+  std::printf("[ figures ] triangle %.4f, Otsu %.4f\n", triangle, OtsuThreshold(values));
+  EXPECT_GT(triangle, 0.015);
+  EXPECT_LT(triangle, 0.05);
+  EXPECT_GT(OtsuThreshold(values), 0.1);
 }
 
 // A bright disk in front of a textured background, in colour, with sensor noise.
@@ -158,6 +176,17 @@ TEST(Silhouettes, OptionsAreChecked) {
   }
   EXPECT_EQ(ParseEvidenceSource("background"), EvidenceSource::kBackground);
   EXPECT_THROW(ParseEvidenceSource("silhouette"), Error);
+}
+
+// ../shared/data/blob has masks, a background and motion: kAuto takes the masks, as given.
+TEST(Silhouettes, AutoSourceTakesGivenMasksFirst) {
+  const Dataset blob(SUBFLOW_SHARED_DIR "/data/blob");
+  const std::vector<Silhouette> silhouettes = ComputeSilhouettes(blob, 3);
+  ASSERT_EQ(static_cast<int>(silhouettes.size()), blob.camera_count());
+  for (int c = 0; c < blob.camera_count(); ++c) {
+    EXPECT_EQ(silhouettes[c].source, EvidenceSource::kMask);
+    EXPECT_EQ(cv::countNonZero(silhouettes[c].mask != blob.Mask(c, 3)), 0);
+  }
 }
 
 // A tiny dataset on disk: 3 cameras, 3 frames, no masks, no background.
