@@ -11,7 +11,9 @@
 //      (re-linearization / warping, normal_flow_constraints.h), solve for the total
 //      displacement coarse to fine over the levels (normal_flow_solver.h). Blob-like
 //      motion of ~0.7 px per frame is within the linear range of σ ≈ 1–1.5 px, and the
-//      second pass removes most of the linearization error.
+//      second pass removes most of the linearization error (blob, frames 0 → 1, samples
+//      seen twice: end-point error 14.5 % of the motion with one pass at σ = 1, 3.0 % with
+//      σ = 1.5 then 1, 2.7 % with a third pass at σ = 1 for 1.7× the time).
 // Images are gray per camera (GrayFloat accepts 8/16-bit, float, BGR); they must be
 // undistorted (vision::Camera::UndistortImage) when the cameras have distortion.
 #pragma once

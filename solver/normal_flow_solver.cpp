@@ -4,13 +4,15 @@
 #include <cmath>
 #include <string>
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/IterativeLinearSolvers>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "geometry/error.h"
 #include "geometry/local_frames.h"
 #include "geometry/loop_operators.h"
+#include "solver/conjugate_gradient.h"
+#include "solver/constraint_collinearity.h"
 
 namespace subflow::solver {
 namespace {
@@ -33,20 +35,6 @@ Sparse Kron3(const Matrix& A) {
   Sparse result(3 * A.rows(), 3 * A.cols());
   result.setFromTriplets(triplets.begin(), triplets.end());
   return result;
-}
-
-double Tukey(double x) {
-  if (std::abs(x) >= 1.0) return 0.0;
-  const double t = 1.0 - x * x;
-  return t * t;
-}
-
-double MedianAbs(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  for (double& v : values) v = std::abs(v);
-  const std::size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
 }
 
 }  // namespace
@@ -72,6 +60,8 @@ void NormalFlowSolverOptions::Check() const {
                "expected ≥ 3 (two planes always intersect in a line)");
   if (!std::isfinite(cg_tolerance) || cg_tolerance <= 0.0 || cg_tolerance >= 1.0)
     ThrowError("normal flow solver", "cg_tolerance", "expected a value in (0, 1)");
+  if (!std::isfinite(min_samples_per_face) || min_samples_per_face < 0.0)
+    ThrowError("normal flow solver", "min_samples_per_face", "expected a finite value ≥ 0");
   if (cg_max_iterations < 1)
     ThrowError("normal flow solver", "cg_max_iterations", "expected ≥ 1");
 }
@@ -84,7 +74,13 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   options_.Check();
   n_ = hierarchy.finest_level();
   lo_ = options_.coarsest_level;
-  hi_ = options_.finest_level < 0 ? n_ : options_.finest_level;
+  hi_ = options_.finest_level;
+  if (hi_ < 0) {
+    hi_ = lo_;
+    while (hi_ < n_ && static_cast<double>(sample_limit.rows()) / hierarchy.FaceCount(hi_ + 1) >=
+                           options_.min_samples_per_face)
+      ++hi_;
+  }
   if (hi_ > n_ || lo_ > n_)
     ThrowError("normal flow solver", "levels",
                "coarsest/finest level beyond the hierarchy's finest level " + std::to_string(n_));
@@ -134,6 +130,7 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
 
   // Prolongations P_i = C(n−1)⋯C(i), Laplacian Gram matrices, length scales.
   prolongation3_.resize(n_ + 1);
+  refinement3_.resize(n_ + 1);
   smoothness3_.resize(n_ + 1);
   length_ratio4_.assign(n_ + 1, 0.0);
   geometry::SparseMatrix P(vertices, vertices);
@@ -150,7 +147,10 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   if (!(radius > 0.0) || !(finest_edge > 0.0))
     ThrowError("normal flow solver", "reference control points", "are degenerate (zero size)");
   for (int level = n_; level >= lo_; --level) {
-    if (level < n_) P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
+    if (level < n_) {
+      P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
+      refinement3_[level] = Kron3(hierarchy.Refinement(level));
+    }
     if (level <= hi_) {
       prolongation3_[level] = Kron3(P);
       const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(hierarchy.Topology(level));
@@ -163,62 +163,6 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
   SUBFLOW_CHECK(displacement.rows() == limit_.cols(), "displacement of another level");
   return limit_ * displacement;
-}
-
-Eigen::VectorXd NormalFlowSolver::CollinearityWeights(const NormalFlowConstraints& constraints,
-                                                      int* pruned) const {
-  const int count = constraints.size();
-  Eigen::VectorXd weights = Eigen::VectorXd::Ones(count);
-  *pruned = 0;
-  if (!options_.collinearity_pruning) return weights;
-  // Constraints per sample (counting sort: any row order is accepted).
-  const int samples = static_cast<int>(limit_.rows());
-  std::vector<int> first(samples + 1, 0), rows(count);
-  for (int c = 0; c < count; ++c) ++first[constraints.sample[c] + 1];
-  for (int s = 0; s < samples; ++s) first[s + 1] += first[s];
-  std::vector<int> fill(first.begin(), first.end() - 1);
-  for (int c = 0; c < count; ++c) rows[fill[constraints.sample[c]]++] = c;
-
-  Eigen::VectorXd residual = Eigen::VectorXd::Zero(count);
-  std::vector<char> tested(count, 0);
-  tbb::parallel_for(0, samples, [&](int s) {
-    const int k = first[s + 1] - first[s];
-    if (k < options_.collinearity_min_cameras) return;
-    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    for (int i = first[s]; i < first[s + 1]; ++i) {
-      const Eigen::Vector3d g = constraints.gradient.row(rows[i]).transpose();
-      normal += g * g.transpose();
-      rhs += constraints.rhs(rows[i]) * g;
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal);
-    const double largest = eigen.eigenvalues()(2);
-    if (!(largest > 0.0)) return;
-    // Rank-2 solution: the two largest eigen-directions (ascending order: columns 1, 2).
-    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-    for (int j = 1; j < 3; ++j) {
-      const double lambda = eigen.eigenvalues()(j);
-      if (lambda <= 1e-9 * largest) continue;
-      const Eigen::Vector3d u = eigen.eigenvectors().col(j);
-      velocity += (u.dot(rhs) / lambda) * u;
-    }
-    for (int i = first[s]; i < first[s + 1]; ++i) {
-      const int c = rows[i];
-      residual(c) = constraints.gradient.row(c).dot(velocity.transpose()) - constraints.rhs(c);
-      tested[c] = 1;
-    }
-  });
-  std::vector<double> tested_residuals;
-  for (int c = 0; c < count; ++c)
-    if (tested[c]) tested_residuals.push_back(residual(c));
-  const double sigma = std::max(1.4826 * MedianAbs(tested_residuals), options_.noise_floor);
-  if (!(sigma > 0.0)) return weights;
-  for (int c = 0; c < count; ++c) {
-    if (!tested[c]) continue;
-    weights(c) = Tukey(residual(c) / (options_.robust_threshold * sigma));
-    if (weights(c) == 0.0) ++*pruned;
-  }
-  return weights;
 }
 
 std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
@@ -269,28 +213,35 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
   }
   N.outerIndexPtr()[3 * vertices] = 9 * static_cast<int>(pattern_.nonZeros());
   double* values = N.valuePtr();
-  std::fill(values, values + 9 * pattern_.nonZeros(), 0.0);
-  for (int s = 0; s < samples; ++s) {
-    const Eigen::Matrix<double, 1, 6> m6 = M.row(s);
-    if (m6(0) == 0.0 && m6(3) == 0.0 && m6(5) == 0.0) continue;
-    Eigen::Matrix3d Ms;
-    Ms << m6(0), m6(1), m6(2), m6(1), m6(3), m6(4), m6(2), m6(4), m6(5);
-    const int begin = limit_.outerIndexPtr()[s], k = limit_.outerIndexPtr()[s + 1] - begin;
-    const int* columns = limit_.innerIndexPtr() + begin;
-    const double* l = limit_.valuePtr() + begin;
-    const int* pairs = pair_entry_.data() + sample_pair_offset_[s];
-    for (int q = 0; q < k; ++q) {
-      const int j = columns[q];
-      const int m = outer[j + 1] - outer[j];
-      for (int p = 0; p < k; ++p) {
-        const double w = l[p] * l[q];
-        const int t = pairs[p * k + q] - outer[j];
-        double* block = values + 9 * outer[j] + 3 * t;
-        for (int b = 0; b < 3; ++b)
-          for (int a = 0; a < 3; ++a) block[3 * m * b + a] += w * Ms(a, b);
+  const std::size_t value_count = 9 * static_cast<std::size_t>(pattern_.nonZeros());
+  std::fill(values, values + value_count, 0.0);
+  // Parallel over samples, each thread into its own copy of the values, summed after.
+  tbb::enumerable_thread_specific<std::vector<double>> partial_values(
+      [&] { return std::vector<double>(value_count, 0.0); });
+  tbb::parallel_for(tbb::blocked_range<int>(0, samples, 4096), [&](const tbb::blocked_range<int>& range) {
+    double* local = partial_values.local().data();
+    for (int s = range.begin(); s < range.end(); ++s) {
+      const Eigen::Matrix<double, 1, 6> m6 = M.row(s);
+      if (m6(0) == 0.0 && m6(3) == 0.0 && m6(5) == 0.0) continue;
+      const double Ms[3][3] = {{m6(0), m6(1), m6(2)}, {m6(1), m6(3), m6(4)}, {m6(2), m6(4), m6(5)}};
+      const int begin = limit_.outerIndexPtr()[s], k = limit_.outerIndexPtr()[s + 1] - begin;
+      const int* columns = limit_.innerIndexPtr() + begin;
+      const double* l = limit_.valuePtr() + begin;
+      const int* pairs = pair_entry_.data() + sample_pair_offset_[s];
+      for (int q = 0; q < k; ++q) {
+        const int j = columns[q];
+        const int m = outer[j + 1] - outer[j];
+        for (int p = 0; p < k; ++p) {
+          const double w = l[p] * l[q];
+          double* block = local + 9 * outer[j] + 3 * (pairs[p * k + q] - outer[j]);
+          for (int b = 0; b < 3; ++b)
+            for (int a = 0; a < 3; ++a) block[3 * m * b + a] += w * Ms[a][b];
+        }
       }
     }
-  }
+  });
+  for (const std::vector<double>& local : partial_values)
+    for (std::size_t i = 0; i < value_count; ++i) values[i] += local[i];
   const Positions q_positions = limit_.transpose() * h;
   const ConstVectorMap q(q_positions.data(), 3 * vertices);
 
@@ -299,10 +250,17 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
   solution->level_motion.resize(n_ + 1);
   solution->levels.clear();
   Positions coarse_motion = Positions::Zero(hierarchy_->VertexCount(lo_), 3);  // W_i
+  // Data matrices of the levels, fine to coarse, one refinement step at a time:
+  // P_iᵀ N P_i = C(i)ᵀ (P_{i+1}ᵀ N P_{i+1}) C(i) (C(i) is much sparser than P_i).
+  std::vector<Sparse> data(n_ + 1);
+  data[n_] = std::move(N);
+  for (int level = n_ - 1; level >= lo_; --level)
+    data[level] = Sparse(refinement3_[level].transpose() * Sparse(data[level + 1] * refinement3_[level]));
+  const Sparse& N_finest = data[n_];
   for (int level = lo_; level <= hi_; ++level) {
     const int unknowns = 3 * hierarchy_->VertexCount(level);
     const Sparse& P3 = prolongation3_[level];
-    Sparse A = level == n_ ? N : Sparse(P3.transpose() * Sparse(N * P3));
+    Sparse A = data[level];
     LevelSolveReport report;
     report.level = level;
     report.unknowns = unknowns;
@@ -319,21 +277,18 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       if (rigid_part[level].rows() == smooth_about.rows()) smooth_about -= rigid_part[level];
       const ConstVectorMap W(smooth_about.data(), unknowns);
       const Eigen::VectorXd rhs =
-          P3.transpose() * (q - N * D) - report.smoothness_weight * (smoothness3_[level] * W);
+          P3.transpose() * (q - N_finest * D) - report.smoothness_weight * (smoothness3_[level] * W);
       A += report.smoothness_weight * smoothness3_[level];
       Sparse identity(unknowns, unknowns);
       identity.setIdentity();
       A += damping * identity;
-      Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper,
-                               Eigen::DiagonalPreconditioner<double>>
-          cg;
-      cg.setTolerance(options_.cg_tolerance);
-      cg.setMaxIterations(options_.cg_max_iterations);
-      cg.compute(A);
-      const Eigen::VectorXd guess = x;
-      x = cg.solveWithGuess(rhs, guess);
-      report.cg_iterations = static_cast<int>(cg.iterations());
-      report.cg_error = cg.error();
+      A.makeCompressed();
+      Eigen::VectorXd solution_vector = x;
+      const ConjugateGradientResult cg = SolveConjugateGradient(
+          A, rhs, options_.cg_tolerance, options_.cg_max_iterations, &solution_vector);
+      x = solution_vector;
+      report.cg_iterations = cg.iterations;
+      report.cg_error = cg.relative_residual;
     } else {
       x.setZero();
     }
@@ -359,7 +314,16 @@ NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constrai
                  "sample index " + std::to_string(constraints.sample[c]) + " out of range");
   NormalFlowSolution solution;
   if (warm_start) solution.level_motion = warm_start->level_motion;
-  solution.collinearity_weights = CollinearityWeights(constraints, &solution.collinearity_pruned);
+  solution.collinearity_weights = Eigen::VectorXd::Ones(constraints.size());
+  if (options_.collinearity_pruning) {
+    CollinearityOptions collinearity;
+    collinearity.min_cameras = options_.collinearity_min_cameras;
+    collinearity.threshold = options_.robust_threshold;
+    collinearity.noise_floor = options_.noise_floor;
+    const CollinearityResult tested = CollinearityWeights(constraints, samples, collinearity);
+    solution.collinearity_weights = tested.weights;
+    solution.collinearity_pruned = tested.pruned;
+  }
   Eigen::VectorXd weights = solution.collinearity_weights;
   Eigen::VectorXd residual;
   Positions previous = warm_start ? warm_start->displacement : Positions();
@@ -371,12 +335,12 @@ NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constrai
     std::vector<double> active;
     for (int c = 0; c < constraints.size(); ++c)
       if (solution.collinearity_weights(c) > 0.0) active.push_back(residual(c));
-    const double sigma = std::max(1.4826 * MedianAbs(active), options_.noise_floor);
+    const double sigma = RobustScale(active, options_.noise_floor);
     if (!(sigma > 0.0)) break;
     solution.robust_scale = sigma;
     for (int c = 0; c < constraints.size(); ++c)
       weights(c) = solution.collinearity_weights(c) *
-                   Tukey(residual(c) / (options_.robust_threshold * sigma));
+                   TukeyWeight(residual(c) / (options_.robust_threshold * sigma));
   }
   solution.weights = weights;
   solution.rigid = FitRigidMotion(control + 0.5 * solution.displacement, solution.displacement);

@@ -62,10 +62,11 @@ void SyntheticRenderOptions::Check() const {
 SyntheticRenderer::SyntheticRenderer(const SyntheticRenderOptions& options)
     : options_(options), albedo_(options.albedo) {
   options_.Check();
+  textured_background_ = options_.background == "texture";
 }
 
 Eigen::Vector3d SyntheticRenderer::BackgroundRadiance(const Camera& camera, double x, double y) const {
-  if (options_.background == "dark") return Eigen::Vector3d::Constant(kBackgroundRadiance);
+  if (!textured_background_) return Eigen::Vector3d::Constant(kBackgroundRadiance);
   const std::uint32_t seed = static_cast<std::uint32_t>(std::hash<std::string>()(camera.name()));
   const double noise = ValueNoise(Eigen::Vector3d(x / 9.0, y / 9.0, 0.5), seed);
   return Eigen::Vector3d::Constant(kBackgroundRadiance * (0.6 + 0.8 * noise));

@@ -67,6 +67,7 @@ class SyntheticRenderer {
                  bool colour, std::uint64_t noise_seed) const;
 
   SyntheticRenderOptions options_;
+  bool textured_background_ = false;
   ProceduralAlbedo albedo_;
 };
 

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "geometry/error.h"
+#include "solver/constraint_collinearity.h"
 #include "solver/image_derivatives.h"
 #include "solver/normal_flow_constraints.h"
 #include "solver/normal_flow_solver.h"
@@ -185,9 +186,12 @@ TEST(NormalFlow, TrueMotionSatisfiesConstraintsOnExactImages) {
 }
 
 // Exact synthetic constraints of the rank-2 structure of real ones (g_k = ∇ρ + λ_k n per
-// sample, 4 views, b = gᵀ u_true) for a translation plus a small rotation: the solver
-// recovers the control displacement to 1 % of its magnitude (the smoothness term's bias
-// on a rotation of a curved surface is what remains; the translation part is exact).
+// sample, 4 views, b = gᵀ u_true) for a translation plus a small rotation (0.57°): the
+// solver recovers the control displacement to 1e-3 of its magnitude (measured 8e-6; CG
+// stops at a relative residual of 1e-4 per level). The smoothness term acts on the motion
+// minus its rigid part; the plain umbrella Laplacian of the velocities biases the rotation
+// (measured 1.5e-3 at the default smoothness 0.003, 1.3e-2 at 0.1), which the second
+// solve shows (> 10× the error).
 struct SyntheticConstraints {
   NormalFlowConstraints constraints;
   Positions true_displacement;
@@ -251,7 +255,15 @@ TEST(NormalFlowSolver, RecoversAKnownMotionFromExactConstraints) {
   const double error = RelativeError(solution.displacement, synthetic.true_displacement);
   std::printf("exact constraints: relative error %.2e, %d CG iterations, %d pruned of %d\n",
               error, solution.cg_iterations, solution.pruned, synthetic.constraints.size());
-  EXPECT_LT(error, 0.01);
+  EXPECT_LT(error, 1e-3);
+  NormalFlowSolverOptions plain_laplacian;
+  plain_laplacian.rigid_invariant_smoothness = false;
+  const double biased = RelativeError(
+      NormalFlowSolver(scene.hierarchy, samples.limit, scene.control, plain_laplacian)
+          .Solve(synthetic.constraints, scene.control).displacement,
+      synthetic.true_displacement);
+  std::printf("plain umbrella smoothness: relative error %.2e\n", biased);
+  EXPECT_GT(biased, 10.0 * error);
   // Base first: the base level alone already carries most of the motion.
   ASSERT_EQ(solution.levels.size(), static_cast<std::size_t>(n + 1));
   const Positions base_only =
@@ -265,10 +277,10 @@ TEST(NormalFlowSolver, RecoversAKnownMotionFromExactConstraints) {
 // with the collinearity test and IRLS, ≥ 95 % of them end with weight 0, the solution stays
 // within 1 % of the clean one's error budget (relative error < 0.02), while plain least
 // squares is thrown off by more than 5 %.
-// DISABLED: work in progress (stop 8) — pruning currently removes about 3.5× as many
-// measurements as were injected bad; the motion-init solver is not finished. The assertions
-// stay as they are; re-enable when the pruning rule is fixed.
-TEST(NormalFlowSolver, DISABLED_PruningRemovesInjectedBadMeasurements) {
+// Each sample has 4 views, so a single bad view is identified by the collinearity test and
+// removed alone; only samples with 2 bad views (~1.4 %) lose all their constraints —
+// hence "fewer than 2 × as many pruned as injected".
+TEST(NormalFlowSolver, PruningRemovesInjectedBadMeasurements) {
   const MotionTestScene& scene = Scene();
   const int n = scene.hierarchy.finest_level();
   const SurfaceSamples samples =
@@ -303,6 +315,47 @@ TEST(NormalFlowSolver, DISABLED_PruningRemovesInjectedBadMeasurements) {
   EXPECT_LT(robust.pruned, 2.0 * bad.size());  // few good rows are lost
   EXPECT_LT(robust_error, 0.02);
   EXPECT_GT(plain_error, 0.05);
+}
+
+// The collinearity test on one sample: five consistent planes through one 3D normal-flow
+// line (g_k = ∇ρ + λ_k n, b_k = g_kᵀ V) keep weight 1; one wrong b is removed alone; with
+// three views and one wrong b the bad view cannot be told apart, the sample is pruned.
+TEST(ConstraintCollinearity, RemovesTheOneInconsistentPlaneOrTheWholeSample) {
+  const Eigen::Vector3d n(0, 0, 1), texture(30, -10, 0), V(0.001, 0.0005, -0.0008);
+  // Sample 0 carries the case under test; samples 1..39 are clean (they fix σ at the
+  // noise floor, as the many good samples of a real step do).
+  constexpr int kSamples = 40;
+  auto make = [&](int views, int bad_view) {
+    NormalFlowConstraints c;
+    c.gradient.resize(kSamples * views, 3);
+    c.rhs.resize(kSamples * views);
+    c.photometric = Eigen::VectorXd::Zero(kSamples * views);
+    for (int s = 0; s < kSamples; ++s)
+      for (int k = 0; k < views; ++k) {
+        const int row = s * views + k;
+        const Eigen::Vector3d g = texture + (20.0 * k - 35.0) * n;
+        c.sample.push_back(s);
+        c.camera.push_back(k);
+        c.gradient.row(row) = g.transpose();
+        c.rhs(row) = g.dot(V) + (s == 0 && k == bad_view ? 0.2 : 0.0);
+      }
+    return c;
+  };
+  const CollinearityOptions options;
+  const CollinearityResult clean = CollinearityWeights(make(5, -1), kSamples, options);
+  EXPECT_EQ(clean.pruned, 0);
+  EXPECT_NEAR(clean.weights.minCoeff(), 1.0, 1e-6);
+  const CollinearityResult one_bad = CollinearityWeights(make(5, 2), kSamples, options);
+  EXPECT_EQ(one_bad.pruned, 1);
+  EXPECT_EQ(one_bad.weights(2), 0.0);
+  EXPECT_EQ(one_bad.removed_single, 1);
+  const CollinearityResult three_views = CollinearityWeights(make(3, 1), kSamples, options);
+  EXPECT_EQ(three_views.pruned, 3);
+  EXPECT_EQ(three_views.pruned_samples, 1);
+  EXPECT_NEAR(TukeyWeight(0.5), 0.5625, 1e-15);
+  EXPECT_EQ(TukeyWeight(1.0), 0.0);
+  EXPECT_NEAR(RobustScale({1.0, -2.0, 3.0}, 0.0), 1.4826 * 2.0, 1e-12);
+  EXPECT_EQ(RobustScale({1e-9, -1e-9, 0.0}, 0.002), 0.002);
 }
 
 }  // namespace
