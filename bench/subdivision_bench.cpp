@@ -12,18 +12,27 @@
 //                           changes its input, so each iteration starts from a fresh copy
 //                           of the base Surface_mesh; the copy is excluded from the
 //                           timing (PauseTiming/ResumeTiming).
+//   BM_OpenMeshLoop         OpenMesh::Subdivider::Uniform::LoopT (double points), 4
+//                           iterations, on a TriMesh of the same base mesh, from a fresh
+//                           copy excluded from the timing as for CGAL. Built only when
+//                           CMake finds OpenMesh (Debian libopenmesh-dev).
 //   BM_HierarchyConstruction  the one-time cost of LoopHierarchy (connectivity and all
 //                           operators of levels 0..4), for scale.
-// CGAL is single-threaded; ours is timed with one TBB thread and with all cores. Run with
+// CGAL and OpenMesh are single-threaded; ours is timed with one TBB thread and with all cores. Run with
 //   subdivision_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/subdivision_method_3.h>
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
+#ifdef SUBFLOW_HAVE_OPENMESH
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Tools/Subdivider/Uniform/LoopT.hh>
+#endif
 
 #include "geometry/icosphere.h"
 #include "geometry/loop_hierarchy.h"
@@ -109,30 +118,79 @@ void BM_LimitTessellation(benchmark::State& state) {
 }
 BENCHMARK(BM_LimitTessellation)->ArgName("threads")->Arg(1)->Arg(0)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-void BM_CgalLoopSubdivision(benchmark::State& state) {
-  const Fixture& f = GetFixture();
-  SurfaceMesh base;
-  std::vector<SurfaceMesh::Vertex_index> vertices;
-  for (Eigen::Index v = 0; v < f.base.V.rows(); ++v)
-    vertices.push_back(base.add_vertex(Kernel::Point_3(f.base.V(v, 0), f.base.V(v, 1), f.base.V(v, 2))));
-  for (Eigen::Index t = 0; t < f.base.F.rows(); ++t)
-    base.add_face(vertices[f.base.F(t, 0)], vertices[f.base.F(t, 1)], vertices[f.base.F(t, 2)]);
+// Builds `mesh` in a reference library's type: add_vertex(x, y, z) returns a Handle,
+// add_face(a, b, c) takes three of them.
+template <typename Handle, typename AddVertex, typename AddFace>
+void CopyMesh(const TriangleMesh& mesh, AddVertex add_vertex, AddFace add_face) {
+  std::vector<Handle> vertices;
+  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+    vertices.push_back(add_vertex(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)));
+  for (Eigen::Index t = 0; t < mesh.F.rows(); ++t)
+    add_face(vertices[mesh.F(t, 0)], vertices[mesh.F(t, 1)], vertices[mesh.F(t, 2)]);
+}
+
+// Times `subdivide(mesh)` (which returns the face count it produced) on a fresh copy of
+// `base` per iteration, as the reference libraries subdivide in place. Copying and
+// destroying the mesh are excluded from the timing; a wrong face count fails the run.
+template <typename Mesh, typename Subdivide>
+void TimeOnFreshCopies(benchmark::State& state, const Mesh& base, Subdivide subdivide,
+                       int expected_faces) {
   for (auto _ : state) {
     state.PauseTiming();
-    SurfaceMesh mesh = base;
+    Mesh mesh = base;
     state.ResumeTiming();
-    CGAL::Subdivision_method_3::Loop_subdivision(mesh, CGAL::parameters::number_of_iterations(kLevels));
-    benchmark::DoNotOptimize(mesh.number_of_faces());
+    const int faces = subdivide(mesh);
+    benchmark::DoNotOptimize(faces);
     state.PauseTiming();
-    if (static_cast<int>(mesh.number_of_faces()) != f.hierarchy.FaceCount(kLevels))
-      state.SkipWithError("CGAL produced a different face count");
+    if (faces != expected_faces) state.SkipWithError("the subdivision produced a different face count");
     {
-      SurfaceMesh discard = std::move(mesh);  // destruction excluded from the timing too
+      Mesh discard = std::move(mesh);
     }
     state.ResumeTiming();
   }
 }
+
+void BM_CgalLoopSubdivision(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  SurfaceMesh base;
+  CopyMesh<SurfaceMesh::Vertex_index>(
+      f.base, [&](double x, double y, double z) { return base.add_vertex(Kernel::Point_3(x, y, z)); },
+      [&](auto a, auto b, auto c) { base.add_face(a, b, c); });
+  TimeOnFreshCopies(
+      state, base,
+      [](SurfaceMesh& mesh) {
+        CGAL::Subdivision_method_3::Loop_subdivision(
+            mesh, CGAL::parameters::number_of_iterations(kLevels));
+        return static_cast<int>(mesh.number_of_faces());
+      },
+      f.hierarchy.FaceCount(kLevels));
+}
 BENCHMARK(BM_CgalLoopSubdivision)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+#ifdef SUBFLOW_HAVE_OPENMESH
+// Double-precision points, as ours and CGAL's (OpenMesh's default is float).
+struct OpenMeshTraits : OpenMesh::DefaultTraits {
+  using Point = OpenMesh::Vec3d;
+};
+using OpenMeshTriMesh = OpenMesh::TriMesh_ArrayKernelT<OpenMeshTraits>;
+
+void BM_OpenMeshLoop(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  OpenMeshTriMesh base;
+  CopyMesh<OpenMeshTriMesh::VertexHandle>(
+      f.base, [&](double x, double y, double z) { return base.add_vertex(OpenMesh::Vec3d(x, y, z)); },
+      [&](auto a, auto b, auto c) { base.add_face(a, b, c); });
+  OpenMesh::Subdivider::Uniform::LoopT<OpenMeshTriMesh, double> loop;
+  TimeOnFreshCopies(
+      state, base,
+      [&loop](OpenMeshTriMesh& mesh) {
+        loop(mesh, kLevels);
+        return static_cast<int>(mesh.n_faces());
+      },
+      f.hierarchy.FaceCount(kLevels));
+}
+BENCHMARK(BM_OpenMeshLoop)->UseRealTime()->Unit(benchmark::kMillisecond);
+#endif
 
 void BM_HierarchyConstruction(benchmark::State& state) {
   const Fixture& f = GetFixture();

@@ -13,6 +13,7 @@ packages=(
   libtbb-dev
   libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopenmesh-dev  # optional reference in bench/subdivision_bench
 )
 
 missing=()
