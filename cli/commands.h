@@ -23,6 +23,7 @@ Command AddSynthCommand(CLI::App& app);  // cli/synth_command.cpp
 Command AddEvalCommand(CLI::App& app);   // cli/eval_command.cpp
 Command AddSubdivideCommand(CLI::App& app);  // cli/subdivide_command.cpp
 Command AddHullCommand(CLI::App& app);       // cli/hull_command.cpp
+Command AddReconstructCommand(CLI::App& app);  // cli/reconstruct_command.cpp
 
 inline std::vector<AddCommandFunction> AllCommands() {
   return {
@@ -31,6 +32,7 @@ inline std::vector<AddCommandFunction> AllCommands() {
       AddEvalCommand,
       AddSubdivideCommand,
       AddHullCommand,
+      AddReconstructCommand,
   };
 }
 

@@ -11,6 +11,8 @@
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
 #include "cli/report_json.h"
+#include "cli/result_files.h"
+#include "cli/stage_options.h"
 #include "geometry/mesh_io.h"
 #include "solver/result_writer.h"
 #include "solver/shape_init.h"
@@ -43,18 +45,14 @@ void RunHull(const HullArguments& arguments) {
   const int finest = hierarchy.finest_level();
 
   const fs::path out(arguments.out);
-  fs::create_directories(out / "hull");
-  geometry::WriteMesh((out / "base_mesh.ply").string(), result.base_mesh);
+  WriteHullFiles(arguments.out, result);
   std::vector<geometry::Positions> limit_surfaces;
+  std::vector<std::vector<geometry::Positions>> control;
   for (const solver::FrameShapeInit& frame : result.frames) {
-    const std::string name = vision::FrameName(frame.frame);
-    geometry::WriteMesh((out / "hull" / (name + ".ply")).string(), frame.hull);
-    fs::create_directories(out / "control" / name);
-    for (int level = 0; level <= finest; ++level)
-      geometry::WriteMesh((out / "control" / name / ("level_" + std::to_string(level) + ".ply")).string(),
-                          geometry::TriangleMesh{frame.control[level], hierarchy.LevelFaces(level)});
+    control.push_back(frame.control);
     limit_surfaces.push_back(hierarchy.LimitPositions(finest) * frame.control[finest]);
   }
+  WriteControlFiles(arguments.out, hierarchy, result.frames.front().frame, control);
   solver::WriteResultMeshes(arguments.out, result.frames.front().frame, hierarchy.LevelFaces(finest),
                             limit_surfaces);
 
@@ -83,28 +81,7 @@ Command AddHullCommand(CLI::App& app) {
       ->required()->check(CLI::ExistingDirectory);
   sub->add_option("--out", arguments->out, "Output directory (must be new or empty)")->required();
   sub->add_flag("--overwrite", arguments->overwrite, "Write into a non-empty output directory");
-  sub->add_option("--evidence", arguments->evidence,
-                  "Object evidence: auto (masks, else background, else motion), mask, background, motion")
-      ->capture_default_str();
-  auto& o = arguments->options;
-  sub->add_option("--levels", o.levels, "Subdivision levels above the base mesh")->capture_default_str();
-  sub->add_option("--base-faces", o.simplify.target_face_count, "Faces of the base mesh T0")
-      ->capture_default_str();
-  sub->add_option("--reference-frame", o.reference_frame,
-                  "Frame giving the base connectivity (-1 = middle frame)")->capture_default_str();
-  sub->add_option("--first-frame", o.first_frame, "First frame to process")->capture_default_str();
-  sub->add_option("--frames", o.frame_count, "Number of frames (-1 = to the end)")->capture_default_str();
-  sub->add_option("--resolution", o.carving.resolution,
-                  "Voxels along the longest axis of the working volume (0 = automatic, ~2 px per voxel)")
-      ->capture_default_str();
-  sub->add_option("--min-cameras", o.carving.min_cameras,
-                  "Cameras that must see and support a voxel")->capture_default_str();
-  sub->add_option("--lambda", o.silhouettes.motion_lambda, "λ of the motion evidence (eq. 23)")
-      ->capture_default_str();
-  sub->add_option("--motion-threshold", o.silhouettes.motion_threshold,
-                  "Threshold of the motion evidence (< 0 = automatic, Otsu)")->capture_default_str();
-  sub->add_option("--background-threshold", o.silhouettes.background_threshold,
-                  "Threshold of the background difference (< 0 = automatic, Otsu)")->capture_default_str();
+  AddShapeInitOptions(sub, &arguments->options, &arguments->evidence);
   return {sub, [arguments] { RunHull(*arguments); }};
 }
 

@@ -99,8 +99,9 @@ EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
                                         const EvaluationOptions& options,
                                         Progress* progress = nullptr);
 
-// Frame files "<dir>/000000.ply" … of a directory, checked to be contiguous from 0.
-// Throws naming the directory when it is missing or empty, and the first missing frame.
-std::vector<std::string> ListFrameMeshes(const std::string& directory);
+// Frame files "<dir>/000000.ply" … of a directory, checked to be contiguous from 0, or,
+// when `first_frame` is given, from the first frame present (returned there). Throws
+// naming the directory when it is missing or empty, and the first missing frame.
+std::vector<std::string> ListFrameMeshes(const std::string& directory, int* first_frame = nullptr);
 
 }  // namespace subflow::vision

@@ -57,7 +57,7 @@ std::string ScoresLine(const std::string& label, const FrameScores& s) {
 
 }  // namespace
 
-std::vector<std::string> ListFrameMeshes(const std::string& directory) {
+std::vector<std::string> ListFrameMeshes(const std::string& directory, int* first_frame) {
   std::error_code error;
   if (!fs::is_directory(directory, error))
     ThrowError(directory, "", "missing (expected a directory of <frame>.ply meshes, 000000.ply …)");
@@ -70,11 +70,14 @@ std::vector<std::string> ListFrameMeshes(const std::string& directory) {
   }
   if (frames.empty()) ThrowError(directory, "", "no frame meshes (expected 000000.ply, 000001.ply, …)");
   std::sort(frames.begin(), frames.end());
+  const int first = first_frame ? frames.front() : 0;
+  if (first_frame) *first_frame = first;
   std::vector<std::string> paths;
-  for (int f = 0; f < static_cast<int>(frames.size()); ++f) {
-    if (frames[f] != f)
+  for (int i = 0; i < static_cast<int>(frames.size()); ++i) {
+    const int f = first + i;
+    if (frames[i] != f)
       ThrowError((fs::path(directory) / FrameFileName(f)).string(), "frame " + std::to_string(f),
-                 "missing (frames must be contiguous from 000000; found up to " +
+                 "missing (frames must be contiguous from " + FrameFileName(first) + "; found up to " +
                      FrameFileName(frames.back()) + ")");
     paths.push_back((fs::path(directory) / FrameFileName(f)).string());
   }
@@ -87,12 +90,17 @@ EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
   options.Check();
   const std::string truth_directory = (fs::path(dataset_directory) / "groundtruth" / "mesh").string();
   const std::string result_meshes = (fs::path(result_directory) / "meshes").string();
-  const std::vector<std::string> truth_paths = ListFrameMeshes(truth_directory);
-  const std::vector<std::string> result_paths = ListFrameMeshes(result_meshes);
-  if (truth_paths.size() != result_paths.size())
+  // A result may cover a contiguous part of the sequence (reconstruct --first-frame/--frames).
+  int first = 0;
+  const std::vector<std::string> all_truth_paths = ListFrameMeshes(truth_directory);
+  const std::vector<std::string> result_paths = ListFrameMeshes(result_meshes, &first);
+  if (first + result_paths.size() > all_truth_paths.size())
     ThrowError(result_meshes, "frame count",
-               std::to_string(result_paths.size()) + " frames, but the ground truth (" + truth_directory +
-                   ") has " + std::to_string(truth_paths.size()));
+               "frames " + FrameFileName(first) + "–" + FrameFileName(first + static_cast<int>(result_paths.size()) - 1) +
+                   ", but the ground truth (" + truth_directory + ") has " +
+                   std::to_string(all_truth_paths.size()) + " frames");
+  const std::vector<std::string> truth_paths(all_truth_paths.begin() + first,
+                                             all_truth_paths.begin() + first + result_paths.size());
   geometry::MeshReadOptions read_options;
   read_options.require_manifold = false;  // scoring does not need manifold meshes
   auto load_truth = [&](int f) { return geometry::ReadMesh(truth_paths[f], read_options); };
@@ -117,8 +125,10 @@ EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
     }
     return frame;
   };
-  return EvaluateSequence(static_cast<int>(truth_paths.size()), load_truth, load_result, options, progress,
-                          truth_directory, result_meshes);
+  EvaluationReport report = EvaluateSequence(static_cast<int>(truth_paths.size()), load_truth, load_result,
+                                             options, progress, truth_directory, result_meshes);
+  for (FrameScores& frame : report.frames) frame.frame += first;
+  return report;
 }
 
 std::string EvaluationReport::Table() const {

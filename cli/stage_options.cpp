@@ -1,0 +1,61 @@
+#include "cli/stage_options.h"
+
+namespace subflow::cli {
+
+void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string* evidence) {
+  sub->add_option("--evidence", *evidence,
+                  "Object evidence: auto (masks, else background, else motion), mask, background, motion")
+      ->capture_default_str();
+  sub->add_option("--levels", o->levels, "Subdivision levels above the base mesh")->capture_default_str();
+  sub->add_option("--base-faces", o->simplify.target_face_count, "Faces of the base mesh T0")
+      ->capture_default_str();
+  sub->add_option("--reference-frame", o->reference_frame,
+                  "Frame giving the base connectivity (-1 = middle frame)")->capture_default_str();
+  sub->add_option("--first-frame", o->first_frame, "First frame to process")->capture_default_str();
+  sub->add_option("--frames", o->frame_count, "Number of frames (-1 = to the end)")->capture_default_str();
+  sub->add_option("--resolution", o->carving.resolution,
+                  "Voxels along the longest axis of the working volume (0 = automatic, ~2 px per voxel)")
+      ->capture_default_str();
+  sub->add_option("--min-cameras", o->carving.min_cameras,
+                  "Cameras that must see and support a voxel")->capture_default_str();
+  sub->add_option("--lambda", o->silhouettes.motion_lambda, "λ of the motion evidence (eq. 23)")
+      ->capture_default_str();
+  sub->add_option("--motion-threshold", o->silhouettes.motion_threshold,
+                  "Threshold of the motion evidence (< 0 = automatic, Otsu)")->capture_default_str();
+  sub->add_option("--background-threshold", o->silhouettes.background_threshold,
+                  "Threshold of the background difference (< 0 = automatic, Otsu)")->capture_default_str();
+}
+
+void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o) {
+  sub->add_option("--motion-smoothness", o->step.solver.smoothness,
+                  "Smoothness weight of the normal-flow solver (aperture problem)")->capture_default_str();
+  sub->add_option("--hull-weight", o->hull_weight,
+                  "Blend of the per-frame normal correction towards the frame's hull fit (0 = off)")
+      ->capture_default_str();
+}
+
+void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
+  sub->add_option("--refine-from", o->coarsest_level, "Coarsest level refined by stereo")
+      ->capture_default_str();
+  sub->add_option("--refine-to", o->finest_level,
+                  "Finest level refined by stereo (-1 = one below the finest level)")->capture_default_str();
+  sub->add_option("--window", o->window, "Frames refined jointly")->capture_default_str();
+  sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
+  sub->add_option("--iterations", o->max_iterations, "Ceres iterations per round")->capture_default_str();
+  sub->add_option("--linear-solver", o->linear_solver,
+                  "Ceres linear solver: sparse_normal_cholesky, cgnr, iterative_schur, sparse_schur")
+      ->capture_default_str();
+  sub->add_option("--threads", o->threads, "Ceres threads (0 = all cores)")->capture_default_str();
+  sub->add_option("--max-cameras", o->max_cameras, "Best-facing cameras paired per patch")
+      ->capture_default_str();
+  sub->add_option("--temporal-weight", o->temporal_weight,
+                  "Weight of the temporal self-correlation (motion along the surface)")->capture_default_str();
+  sub->add_option("--silhouette-weight", o->silhouette_weight, "Weight of the outline term per pixel")
+      ->capture_default_str();
+  sub->add_option("--membrane-weight", o->membrane_weight, "Spatial smoothness of the corrections")
+      ->capture_default_str();
+  sub->add_option("--temporal-smoothness", o->temporal_smoothness,
+                  "Temporal smoothness of the corrections")->capture_default_str();
+}
+
+}  // namespace subflow::cli

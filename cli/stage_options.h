@@ -1,0 +1,24 @@
+// Command-line options of the pipeline stages, shared by the subcommands that run them.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "solver/motion_init.h"
+#include "solver/shape_init.h"
+#include "solver/stereo_refinement.h"
+
+namespace subflow::cli {
+
+// --evidence, --levels, --base-faces, --reference-frame, --first-frame, --frames,
+// --resolution, --min-cameras, --lambda, --motion-threshold, --background-threshold.
+void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::string* evidence);
+
+// --motion-smoothness, --hull-weight.
+void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options);
+
+// --refine-levels, --window, --rounds, --iterations, --linear-solver, --threads, ...
+void AddRefinementOptions(CLI::App* app, solver::StereoRefinementOptions* options);
+
+}  // namespace subflow::cli

@@ -1,0 +1,95 @@
+#include "solver/reconstruction.h"
+
+#include <chrono>
+
+#include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
+
+#include "geometry/error.h"
+#include "vision/zbuffer.h"
+
+namespace subflow::solver {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+void ReconstructionOptions::Check() const {
+  shape.Check();
+  motion.Check();
+  if (refine) refinement.Check();
+}
+
+geometry::Positions ReconstructionResult::Surface(int i) const {
+  const geometry::LoopHierarchy& h = hierarchy();
+  return h.LimitPositions(h.finest_level()) * control.at(i);
+}
+
+RefinementImageLoader SilhouetteLoader(const vision::Dataset& dataset, const ShapeInitResult& shape) {
+  const int first = shape.frames.empty() ? 0 : shape.frames.front().frame;
+  if (dataset.has_masks()) {
+    return [&dataset, first](int camera, int frame) {
+      const vision::Camera& cam = dataset.camera(camera);
+      const cv::Mat mask = dataset.Mask(camera, first + frame);
+      return cam.HasDistortion() ? cam.UndistortImage(mask, cv::INTER_NEAREST) : mask;
+    };
+  }
+  return [&dataset, &shape](int camera, int frame) {
+    const geometry::TriangleMesh& hull = shape.frames.at(frame).hull;
+    if (hull.F.rows() == 0) return cv::Mat();
+    return vision::ZBuffer(dataset.camera(camera), hull.V, hull.F).Mask();
+  };
+}
+
+ReconstructionResult Reconstruct(const vision::Dataset& dataset, const ReconstructionOptions& options,
+                                 Progress* progress) {
+  options.Check();
+  ReconstructionResult result;
+
+  auto start = Clock::now();
+  result.shape = InitializeShape(dataset, options.shape, progress);
+  result.shape_seconds = SecondsSince(start);
+  const geometry::LoopHierarchy& hierarchy = result.hierarchy();
+  const int finest = hierarchy.finest_level();
+  result.first_frame = result.shape.frames.front().frame;
+  const int frames = static_cast<int>(result.shape.frames.size());
+
+  // Motion initialization from the reference frame's fit, corrected towards every frame's.
+  start = Clock::now();
+  std::vector<geometry::Positions> fitted(frames);
+  for (int i = 0; i < frames; ++i) fitted[i] = result.shape.frames[i].control.at(finest);
+  const int first = result.first_frame;
+  const GrayImageLoader gray = [&dataset, first](int camera, int frame) {
+    const vision::Camera& cam = dataset.camera(camera);
+    cv::Mat image = dataset.Gray(camera, first + frame);
+    return cam.HasDistortion() ? cam.UndistortImage(image) : image;
+  };
+  result.motion = InitializeMotion(dataset.cameras(), frames, gray, hierarchy, fitted,
+                                   result.shape.reference_frame - first, options.motion, progress);
+  result.motion_seconds = SecondsSince(start);
+  result.control = result.motion.control;
+
+  if (options.refine) {
+    start = Clock::now();
+    result.refinement = RefineStereo(dataset.cameras(), gray, SilhouetteLoader(dataset, result.shape),
+                                     hierarchy, result.control, dataset.bounds(), options.refinement,
+                                     progress);
+    result.control = result.refinement->control;
+    result.refinement_seconds = SecondsSince(start);
+  }
+
+  start = Clock::now();
+  result.trajectory = geometry::AnalyzeTrajectory(hierarchy, result.control);
+  std::vector<geometry::Positions> bases;
+  for (const geometry::MultiresShape& shape : result.trajectory) bases.push_back(shape.base());
+  result.rigid = FitRigidMotions(bases);
+  result.analysis_seconds = SecondsSince(start);
+  return result;
+}
+
+}  // namespace subflow::solver
