@@ -1,59 +1,32 @@
 // `subflow check` end to end: exit status, one-line errors, JSON output.
-#include <unistd.h>
-
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/test_support.h"
+
+namespace subflow {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 class CheckCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("subflow_check_command_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  CommandResult Subflow(const std::string& arguments) const {
-    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string command = std::string("'") + SUBFLOW_BINARY + "' " + arguments + " >'" +
-                                out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(command.c_str());
-    CommandResult run;
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = Slurp(out);
-    run.err = Slurp(err);
-    return run;
+  test::CommandResult Subflow(const std::string& arguments) const {
+    return test::RunSubflow(arguments, dir_.path());
   }
 
-  fs::path dir_;
+  const test::TemporaryDirectory dir_{"check_command"};
 };
 
 const std::string kBlobMesh =
     std::string(SUBFLOW_SHARED_DIR) + "/data/blob/groundtruth/mesh/000000.ply";
 
 TEST_F(CheckCommand, ValidMeshExitsZeroAndPrintsItsFigures) {
-  const CommandResult run = Subflow("check '" + kBlobMesh + "'");
+  const test::CommandResult run = Subflow("check '" + kBlobMesh + "'");
   EXPECT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("10242 vertices, 20480 faces"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("genus 0"), std::string::npos) << run.out;
@@ -62,7 +35,7 @@ TEST_F(CheckCommand, ValidMeshExitsZeroAndPrintsItsFigures) {
 }
 
 TEST_F(CheckCommand, JsonOutputParsesAndSkippingIntersectionsIsHonoured) {
-  const CommandResult run = Subflow("check --json --no-self-intersections '" + kBlobMesh + "'");
+  const test::CommandResult run = Subflow("check --json --no-self-intersections '" + kBlobMesh + "'");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json json = nlohmann::json::parse(run.out);
   EXPECT_EQ(json["valid"], true);
@@ -76,7 +49,7 @@ TEST_F(CheckCommand, InvalidOrUnreadableMeshExitsOneWithAOneLineError) {
   // Two triangles sharing only vertex 0 (a bowtie): readable, but not a manifold.
   const fs::path bowtie = dir_ / "bowtie.obj";
   std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv -1 0 0\nv -1 -1 0\nf 1 2 3\nf 1 4 5\n";
-  const CommandResult invalid = Subflow("check '" + bowtie.string() + "'");
+  const test::CommandResult invalid = Subflow("check '" + bowtie.string() + "'");
   EXPECT_EQ(invalid.exit_code, 1);
   EXPECT_EQ(invalid.err.rfind("subflow check: error: " + bowtie.string() + ": invalid mesh:", 0),
             0u)
@@ -86,23 +59,24 @@ TEST_F(CheckCommand, InvalidOrUnreadableMeshExitsOneWithAOneLineError) {
 
   const fs::path quad = dir_ / "quad.obj";
   std::ofstream(quad) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
-  const CommandResult unreadable = Subflow("check '" + quad.string() + "'");
+  const test::CommandResult unreadable = Subflow("check '" + quad.string() + "'");
   EXPECT_EQ(unreadable.exit_code, 1);
   EXPECT_NE(unreadable.err.find(quad.string() + ": line 5 (face 0): has 4 vertices"),
             std::string::npos)
       << unreadable.err;
   EXPECT_TRUE(unreadable.out.empty()) << unreadable.out;
 
-  const CommandResult missing = Subflow("check '" + (dir_ / "missing.ply").string() + "'");
+  const test::CommandResult missing = Subflow("check '" + (dir_ / "missing.ply").string() + "'");
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("no such file"), std::string::npos) << missing.err;
 }
 
 TEST_F(CheckCommand, HelpDescribesTheVerdict) {
-  const CommandResult run = Subflow("check --help");
+  const test::CommandResult run = Subflow("check --help");
   EXPECT_EQ(run.exit_code, 0);
   EXPECT_NE(run.out.find("--no-self-intersections"), std::string::npos) << run.out;
   EXPECT_NE(run.out.find("Exit status"), std::string::npos) << run.out;
 }
 
 }  // namespace
+}  // namespace subflow

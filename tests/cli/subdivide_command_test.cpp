@@ -1,12 +1,8 @@
 // `subflow subdivide` end to end: the written mesh is LoopHierarchy's refinement (or its
 // limit positions), bad input gives a one-line error and exit status 1.
-#include <unistd.h>
-
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -14,45 +10,20 @@
 #include "geometry/loop_hierarchy.h"
 #include "geometry/mesh_io.h"
 #include "geometry/mesh_primitives.h"
+#include "tests/test_support.h"
 
 namespace subflow::geometry {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 class SubdivideCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("subflow_subdivide_command_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  CommandResult Subflow(const std::string& arguments) const {
-    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string command = std::string("'") + SUBFLOW_BINARY + "' " + arguments + " >'" +
-                                out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(command.c_str());
-    CommandResult run;
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = Slurp(out);
-    run.err = Slurp(err);
-    return run;
+  test::CommandResult Subflow(const std::string& arguments) const {
+    return test::RunSubflow(arguments, dir_.path());
   }
 
-  fs::path dir_;
+  const test::TemporaryDirectory dir_{"subdivide_command"};
 };
 
 // PLY stores float coordinates: 1e-6 of unit coordinates covers the rounding to float.
@@ -67,7 +38,7 @@ TEST_F(SubdivideCommand, WritesTheRefinedControlMeshAndItsLimitPositions) {
   const Positions control = hierarchy.Refine(base.V, 0, 2);
 
   const std::string control_path = (dir_ / "control.ply").string();
-  CommandResult run = Subflow("subdivide '" + input + "' --levels 2 --out '" + control_path + "'");
+  test::CommandResult run = Subflow("subdivide '" + input + "' --levels 2 --out '" + control_path + "'");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("66 vertices, 128 faces"), std::string::npos) << run.out;
   const TriangleMesh written = ReadMesh(control_path);
@@ -88,7 +59,7 @@ TEST_F(SubdivideCommand, BadInputGivesAOneLineErrorAndExitStatusOne) {
   // Two triangles sharing only a vertex: not a manifold.
   const std::string bowtie = (dir_ / "bowtie.obj").string();
   std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n";
-  CommandResult run = Subflow("subdivide '" + bowtie + "' --levels 1 --out '" +
+  test::CommandResult run = Subflow("subdivide '" + bowtie + "' --levels 1 --out '" +
                               (dir_ / "out.ply").string() + "'");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("subflow subdivide: error: " + bowtie), std::string::npos) << run.err;
@@ -100,7 +71,7 @@ TEST_F(SubdivideCommand, BadInputGivesAOneLineErrorAndExitStatusOne) {
 }
 
 TEST_F(SubdivideCommand, HelpDescribesTheOptions) {
-  const CommandResult run = Subflow("subdivide --help");
+  const test::CommandResult run = Subflow("subdivide --help");
   EXPECT_EQ(run.exit_code, 0);
   for (const char* option : {"--levels", "--limit", "--out", "IN"})
     EXPECT_NE(run.out.find(option), std::string::npos) << option;

@@ -1,7 +1,5 @@
 #include "geometry/mesh_io.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -11,11 +9,11 @@
 #include <initializer_list>
 #include <limits>
 #include <random>
-#include <sstream>
 
 #include <gtest/gtest.h>
 
 #include "geometry/error.h"
+#include "tests/test_support.h"
 
 namespace subflow::geometry {
 namespace {
@@ -48,14 +46,6 @@ double AsFloat(double value) { return static_cast<double>(static_cast<float>(val
 
 class MeshIo : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("subflow_mesh_io_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   std::string Path(const std::string& name) const { return (dir_ / name).string(); }
 
   std::string WriteFile(const std::string& name, const std::string& bytes) const {
@@ -64,12 +54,7 @@ class MeshIo : public ::testing::Test {
     return path;
   }
 
-  static std::string ReadBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    return bytes.str();
-  }
+  static std::string ReadBytes(const std::string& path) { return test::ReadTextFile(path); }
 
   // Reading `path` must fail with a message holding the path and every fragment.
   static void ExpectReadError(const std::string& path, std::initializer_list<std::string> fragments,
@@ -86,7 +71,8 @@ class MeshIo : public ::testing::Test {
     }
   }
 
-  fs::path dir_;
+  const test::TemporaryDirectory dir_{
+      std::string("mesh_io_") + ::testing::UnitTest::GetInstance()->current_test_info()->name()};
 };
 
 // Binary and ASCII PLY store float, so a round trip must give back exactly the float

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <random>
 #include <thread>
 
@@ -20,6 +19,7 @@
 #include "geometry/error.h"
 #include "geometry/mesh_io.h"
 #include "vision/dataset_writer.h"
+#include "tests/test_support.h"
 
 namespace subflow::vision {
 namespace {
@@ -27,23 +27,10 @@ namespace fs = std::filesystem;
 
 const std::string kBlob = SUBFLOW_SHARED_DIR "/data/blob";
 
-fs::path TestRoot() {
-  return fs::temp_directory_path() / ("subflow_dataset_test_" + std::to_string(::getpid()));
-}
-
-// Removes this run's temporary directories at the end.
-class RemoveTemporaries : public ::testing::Environment {
- public:
-  void TearDown() override { fs::remove_all(TestRoot()); }
-};
-const auto* const kRemoveTemporaries = ::testing::AddGlobalTestEnvironment(new RemoveTemporaries);
-
-// A fresh, empty directory for one test.
-fs::path TempDir(const std::string& name) {
-  const fs::path dir = TestRoot() / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+// This run's scratch directory (removed at exit); each test works below it.
+const test::TemporaryDirectory& Scratch() {
+  static const test::TemporaryDirectory scratch("dataset_test");
+  return scratch;
 }
 
 // A camera at `center` looking at the origin, +y of the image pointing down the world −z.
@@ -119,10 +106,7 @@ void EditJson(const fs::path& path, Edit edit) {
 }
 
 void ReplaceInFile(const fs::path& path, const std::string& from, const std::string& to) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string text = buffer.str();
+  std::string text = test::ReadTextFile(path);
   const auto at = text.find(from);
   ASSERT_NE(at, std::string::npos) << from;
   text.replace(at, from.size(), to);
@@ -219,7 +203,7 @@ TEST(Dataset, DerivedWorkingVolumeContainsTheBlob) {
 }
 
 TEST(Dataset, RoundTripGivesIdenticalCamerasAndPixels) {
-  const fs::path dir = TempDir("round_trip");
+  const fs::path dir = Scratch().Subdirectory("round_trip");
   WriteSmallDataset(dir, 3);
   const std::vector<Camera> written = SmallRig();
   const Dataset dataset(dir.string());
@@ -271,7 +255,7 @@ TEST(Dataset, RoundTripGivesIdenticalCamerasAndPixels) {
 }
 
 TEST(Dataset, WriterNeverOverwritesUnlessTold) {
-  const fs::path dir = TempDir("overwrite");
+  const fs::path dir = Scratch().Subdirectory("overwrite");
   std::ofstream(dir / "notes.txt") << "precious";
   const std::string message = ErrorOf([&] { DatasetWriter(dir.string(), SmallRig(), {}); });
   EXPECT_CONTAINS(message, dir.string());
@@ -283,7 +267,7 @@ TEST(Dataset, WriterNeverOverwritesUnlessTold) {
 }
 
 TEST(Dataset, HoldsABoundedWindowOfFrames) {
-  const fs::path dir = TempDir("window");
+  const fs::path dir = Scratch().Subdirectory("window");
   WriteSmallDataset(dir, 4);
   DatasetOptions options;
   options.cache_frames = 1;  // 3 cameras → at most 3 cached entries
@@ -300,7 +284,7 @@ TEST(Dataset, HoldsABoundedWindowOfFrames) {
 }
 
 TEST(Dataset, ConcurrentReadsAgree) {
-  const fs::path dir = TempDir("threads");
+  const fs::path dir = Scratch().Subdirectory("threads");
   WriteSmallDataset(dir, 4);
   const Dataset dataset(dir.string());
   std::vector<double> sums(8);
@@ -318,7 +302,7 @@ TEST(Dataset, ConcurrentReadsAgree) {
 }
 
 TEST(Dataset, ReadsFramesFromVideos) {
-  const fs::path dir = TempDir("videos");
+  const fs::path dir = Scratch().Subdirectory("videos");
   const std::vector<Camera> cameras = {LookAt("a", {-1, -1, 0.3}, 32, 24, 30), LookAt("b", {1, -1, 0.3}, 32, 24, 30)};
   WriteCamerasJson((dir / "cameras.json").string(), cameras, 25.0, std::nullopt, std::nullopt);
   fs::create_directories(dir / "videos");
@@ -342,7 +326,7 @@ TEST(Dataset, ReadsFramesFromVideos) {
 class MalformedDataset : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = TempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = Scratch().Subdirectory(::testing::UnitTest::GetInstance()->current_test_info()->name());
     WriteSmallDataset(dir_, 3);
   }
   std::string OpenError(bool check_headers = true) const {

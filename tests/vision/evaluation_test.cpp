@@ -3,10 +3,8 @@
 #include "vision/evaluation.h"
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -16,6 +14,7 @@
 #include "geometry/mesh_io.h"
 #include "geometry/vertex_normals.h"
 #include "vision/synthetic_scene.h"
+#include "tests/test_support.h"
 
 namespace subflow::vision {
 namespace {
@@ -175,16 +174,14 @@ TEST(Evaluation, SurfaceSamplesAreAreaWeightedAndDeterministic) {
 
 // Files: DATASET/groundtruth/mesh and RESULT/meshes written with WriteMesh.
 struct EvaluationFiles {
+  const test::TemporaryDirectory scratch;
   fs::path root, dataset, result;
-  explicit EvaluationFiles(const std::string& name) {
-    root = fs::temp_directory_path() / ("subflow_eval_test_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(root);
+  explicit EvaluationFiles(const std::string& name) : scratch("eval_test_" + name), root(scratch.path()) {
     dataset = root / "dataset";
     result = root / "result";
     fs::create_directories(dataset / "groundtruth" / "mesh");
     fs::create_directories(result / "meshes");
   }
-  ~EvaluationFiles() { fs::remove_all(root); }
   void Write(const SyntheticScene& truth, bool with_motion) {
     for (int f = 0; f < truth.frame_count(); ++f) {
       char name[16];
@@ -269,25 +266,21 @@ TEST(Evaluation, CommandLinePrintsATableAndWritesJson) {
   EvaluationFiles files("cli");
   files.Write(Blob(), false);
   const fs::path json_path = files.root / "scores.json";
-  const fs::path output = files.root / "output.txt";
-  const std::string command = std::string(SUBFLOW_BINARY) + " eval " + files.dataset.string() + " " +
-                              files.result.string() + " --samples 5000 --json " + json_path.string() + " > " +
-                              output.string() + " 2>&1";
-  ASSERT_EQ(std::system(command.c_str()), 0);
-  std::stringstream text;
-  text << std::ifstream(output).rdbuf();
-  EXPECT_NE(text.str().find("overall"), std::string::npos) << text.str();
+  const test::CommandResult run =
+      test::RunSubflow("eval '" + files.dataset.string() + "' '" + files.result.string() +
+                           "' --samples 5000 --json '" + json_path.string() + "'",
+                       files.root);
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  EXPECT_NE(run.output().find("overall"), std::string::npos) << run.output();
   std::ifstream json_file(json_path);
   const nlohmann::json json = nlohmann::json::parse(json_file);
   EXPECT_EQ(json["samples"].get<int>(), 5000);
   EXPECT_LT(json["overall"]["chamfer"].get<double>(), 1e-7);
   // A missing result directory: exit status 1 and a one-line error naming it.
-  const std::string bad = std::string(SUBFLOW_BINARY) + " eval " + files.dataset.string() + " " +
-                          (files.root / "nowhere").string() + " > " + output.string() + " 2>&1";
-  EXPECT_NE(std::system(bad.c_str()), 0);
-  std::stringstream bad_text;
-  bad_text << std::ifstream(output).rdbuf();
-  EXPECT_NE(bad_text.str().find("nowhere/meshes: missing"), std::string::npos) << bad_text.str();
+  const test::CommandResult bad = test::RunSubflow(
+      "eval '" + files.dataset.string() + "' '" + (files.root / "nowhere").string() + "'", files.root);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output().find("nowhere/meshes: missing"), std::string::npos) << bad.output();
 }
 
 }  // namespace

@@ -14,27 +14,16 @@
 #include "geometry/error.h"
 #include "vision/colmap_import.h"
 #include "vision/projection_matrix_import.h"
+#include "tests/test_support.h"
 
 namespace subflow::vision {
 namespace {
 namespace fs = std::filesystem;
 
-fs::path TestRoot() {
-  return fs::temp_directory_path() / ("subflow_importers_test_" + std::to_string(::getpid()));
-}
-
-// Removes this run's temporary directories at the end.
-class RemoveTemporaries : public ::testing::Environment {
- public:
-  void TearDown() override { fs::remove_all(TestRoot()); }
-};
-const auto* const kRemoveTemporaries = ::testing::AddGlobalTestEnvironment(new RemoveTemporaries);
-
-fs::path TempDir(const std::string& name) {
-  const fs::path dir = TestRoot() / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+// This run's scratch directory (removed at exit); each test works below it.
+const test::TemporaryDirectory& Scratch() {
+  static const test::TemporaryDirectory scratch("importers_test");
+  return scratch;
 }
 
 template <typename Action>
@@ -61,7 +50,7 @@ Eigen::Matrix3d RandomRotation(std::mt19937& random) {
 }
 
 TEST(ColmapImport, RecoversCamerasAndRemovesTheHalfPixelOffset) {
-  const fs::path dir = TempDir("colmap");
+  const fs::path dir = Scratch().Subdirectory("colmap");
   std::mt19937 random(3);
   // COLMAP cameras: id → (model, width, height, params). Principal points in COLMAP's
   // convention (centre of the top-left pixel at (0.5, 0.5)).
@@ -136,7 +125,7 @@ TEST(ColmapImport, RecoversCamerasAndRemovesTheHalfPixelOffset) {
 }
 
 TEST(ColmapImport, MalformedFilesNameFileAndLine) {
-  const fs::path dir = TempDir("colmap_bad");
+  const fs::path dir = Scratch().Subdirectory("colmap_bad");
   std::ofstream(dir / "cameras.txt") << "# comment\n1 PINHOLE 640 480 500 500 320 240\n2 FISHEYE 640 480 1 2 3 4\n";
   std::ofstream(dir / "images.txt") << "1 1 0 0 0 0 0 1 1 a.png\n\n";
   std::string message = ErrorOf([&] { ReadColmapTextModel(dir.string()); });
@@ -184,7 +173,7 @@ void ExpectRecovered(const Camera& read, const TrueCamera& truth) {
 }
 
 TEST(ProjectionMatrixImport, RecoversKRtFromScaledProjectionMatrices) {
-  const fs::path dir = TempDir("dtu");
+  const fs::path dir = Scratch().Subdirectory("dtu");
   std::mt19937 random(11);
   std::vector<TrueCamera> truths;
   const double scales[] = {1.0, -3.7, 0.0021, -250.0, 42.0};  // P is known only up to scale and sign
@@ -229,7 +218,7 @@ TEST(ProjectionMatrixImport, RecoversKRtFromScaledProjectionMatrices) {
 }
 
 TEST(ProjectionMatrixImport, ReadsMiddleburyParameterFiles) {
-  const fs::path dir = TempDir("middlebury");
+  const fs::path dir = Scratch().Subdirectory("middlebury");
   std::mt19937 random(5);
   std::vector<TrueCamera> truths;
   std::ofstream file(dir / "temple_par.txt");

@@ -4,8 +4,6 @@
 // motion is an error that says so.
 #include "vision/silhouettes.h"
 
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -20,6 +18,7 @@
 #include "vision/dataset.h"
 #include "vision/dataset_writer.h"
 #include "vision/voxel_carving.h"
+#include "tests/test_support.h"
 
 namespace subflow::vision {
 namespace {
@@ -193,9 +192,6 @@ TEST(Silhouettes, AutoSourceTakesGivenMasksFirst) {
 class StaticDataset : public ::testing::Test {
  protected:
   void SetUp() override {
-    directory_ = (std::filesystem::temp_directory_path() /
-                  ("subflow_silhouettes_test_" + std::to_string(::getpid())))
-                     .string();
     std::vector<Camera> cameras;
     for (int c = 0; c < 3; ++c) {
       const double angle = 2.0 * M_PI * c / 3.0;
@@ -219,8 +215,8 @@ class StaticDataset : public ::testing::Test {
       for (int f = 0; f < 3; ++f) writer.WriteImage(c, f, image);  // nothing moves
     }
   }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-  std::string directory_;
+  const test::TemporaryDirectory scratch_{"silhouettes_test"};
+  const std::string directory_ = scratch_.string();
 };
 
 TEST_F(StaticDataset, NoMasksNoBackgroundNoMotionIsAnErrorThatSaysSo) {

@@ -5,10 +5,8 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -19,17 +17,17 @@
 #include "vision/dataset.h"
 #include "vision/mask_agreement.h"
 #include "vision/zbuffer.h"
+#include "tests/test_support.h"
 
 namespace subflow::vision {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path TemporaryDirectory(const std::string& name) {
-  const fs::path path = fs::temp_directory_path() / ("subflow_synth_test_" + name + "_" +
-                                                     std::to_string(::getpid()));
-  fs::remove_all(path);
-  return path;
+// This run's scratch directory (removed at exit); each test works below it.
+const test::TemporaryDirectory& Scratch() {
+  static const test::TemporaryDirectory scratch("synth_test");
+  return scratch;
 }
 
 SynthOptions SmallOptions(const std::string& scene, const std::string& rig) {
@@ -72,7 +70,7 @@ void ExpectMasksMatchZBuffer(const fs::path& directory) {
 }
 
 TEST(Synth, BlobRingDatasetMasksMatchTheZBufferOfItsGroundTruth) {
-  const fs::path directory = TemporaryDirectory("blob");
+  const fs::path directory = Scratch().FreshPath("blob");
   const SynthSummary summary = WriteSyntheticDataset(directory.string(), SmallOptions("blob", "ring"));
   EXPECT_EQ(summary.camera_count, 4);
   EXPECT_EQ(summary.frame_count, 3);
@@ -109,18 +107,18 @@ TEST(Synth, BlobRingDatasetMasksMatchTheZBufferOfItsGroundTruth) {
 }
 
 TEST(Synth, RigidDomeAndHeadPartialDomeDatasetsPassTheMaskCheck) {
-  const fs::path rigid = TemporaryDirectory("rigid");
+  const fs::path rigid = Scratch().FreshPath("rigid");
   WriteSyntheticDataset(rigid.string(), SmallOptions("rigid", "dome"));
   ExpectMasksMatchZBuffer(rigid);
   fs::remove_all(rigid);
-  const fs::path head = TemporaryDirectory("head");
+  const fs::path head = Scratch().FreshPath("head");
   WriteSyntheticDataset(head.string(), SmallOptions("head", "partial-dome"));
   ExpectMasksMatchZBuffer(head);
   fs::remove_all(head);
 }
 
 TEST(Synth, RefusesANonEmptyDirectoryUnlessOverwriting) {
-  const fs::path directory = TemporaryDirectory("refuse");
+  const fs::path directory = Scratch().FreshPath("refuse");
   fs::create_directories(directory);
   std::ofstream(directory / "notes.txt") << "keep me\n";
   SynthOptions options = SmallOptions("blob", "ring");
@@ -208,32 +206,21 @@ TEST(Synth, SensorNoiseIsUnbiasedWithTheRequestedDeviation) {
   EXPECT_NEAR(mean[0], level - std::lround(level), 0.1);
 }
 
-std::string RunCommand(const std::string& arguments, int* status) {
-  const fs::path output = TemporaryDirectory("cli_output.txt");
-  const std::string command = std::string(SUBFLOW_BINARY) + " " + arguments + " > " + output.string() + " 2>&1";
-  *status = std::system(command.c_str());
-  std::stringstream text;
-  text << std::ifstream(output).rdbuf();
-  fs::remove(output);
-  return text.str();
-}
-
 TEST(Synth, CommandLineWritesADatasetAndRefusesToOverwrite) {
-  const fs::path directory = TemporaryDirectory("cli");
-  const std::string arguments = "synth rigid --out " + directory.string() +
-                                " --cameras 3 --frames 2 --width 64 --height 48 --subdivisions 3";
-  int status = 0;
-  std::string output = RunCommand(arguments, &status);
-  ASSERT_EQ(status, 0) << output;
+  const fs::path directory = Scratch().FreshPath("cli");
+  const std::string arguments = "synth rigid --out '" + directory.string() +
+                                "' --cameras 3 --frames 2 --width 64 --height 48 --subdivisions 3";
+  test::CommandResult run = test::RunSubflow(arguments, Scratch().path());
+  ASSERT_EQ(run.exit_code, 0) << run.output();
   EXPECT_TRUE(fs::exists(directory / "images" / "cam02" / "000001.png"));
   EXPECT_TRUE(fs::exists(directory / "groundtruth" / "mesh" / "000001.ply"));
-  output = RunCommand(arguments, &status);
-  EXPECT_NE(status, 0);
-  EXPECT_NE(output.find("refusing to overwrite"), std::string::npos) << output;
-  output = RunCommand(arguments + " --overwrite", &status);
-  EXPECT_EQ(status, 0) << output;
-  output = RunCommand("synth cube --out " + directory.string(), &status);
-  EXPECT_NE(status, 0) << output;
+  run = test::RunSubflow(arguments, Scratch().path());
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.output().find("refusing to overwrite"), std::string::npos) << run.output();
+  run = test::RunSubflow(arguments + " --overwrite", Scratch().path());
+  EXPECT_EQ(run.exit_code, 0) << run.output();
+  run = test::RunSubflow("synth cube --out '" + directory.string() + "'", Scratch().path());
+  EXPECT_NE(run.exit_code, 0) << run.output();
   fs::remove_all(directory);
 }
 
