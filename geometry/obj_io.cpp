@@ -1,6 +1,5 @@
 #include "geometry/obj_io.h"
 
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -9,35 +8,9 @@
 #include <vector>
 
 #include "geometry/error.h"
+#include "geometry/text_parsing.h"
 
 namespace subflow::geometry {
-namespace {
-
-std::vector<std::string_view> Tokens(std::string_view line) {
-  std::vector<std::string_view> tokens;
-  size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-    size_t j = i;
-    while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
-    if (j > i) tokens.push_back(line.substr(i, j - i));
-    i = j;
-  }
-  return tokens;
-}
-
-bool ParseDouble(std::string_view token, double* value) {
-  if (!token.empty() && token[0] == '+') token.remove_prefix(1);  // from_chars rejects '+'
-  const char* end = token.data() + token.size();
-  const auto result = std::from_chars(token.data(), end, *value);
-  if (result.ec == std::errc::result_out_of_range && result.ptr == end) {
-    *value = token[0] == '-' ? -HUGE_VAL : HUGE_VAL;
-    return true;
-  }
-  return result.ec == std::errc() && result.ptr == end;
-}
-
-}  // namespace
 
 TriangleMesh ParseObj(const std::string& text, const std::string& source) {
   std::vector<double> positions;
@@ -53,7 +26,7 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
     ++line_number;
     const size_t comment = line.find('#');
     if (comment != std::string_view::npos) line = line.substr(0, comment);
-    const std::vector<std::string_view> tokens = Tokens(line);
+    const std::vector<std::string_view> tokens = SplitTokens(line);
     if (tokens.empty()) continue;
     const std::string where = "line " + std::to_string(line_number);
     if (tokens[0] == "v") {

@@ -2,7 +2,6 @@
 #include "geometry/ply_io.h"
 
 #include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "geometry/error.h"
+#include "geometry/text_parsing.h"
 
 namespace subflow::geometry {
 namespace {
@@ -96,19 +96,6 @@ bool NextLine(const std::string& bytes, size_t* pos, std::string_view* line) {
   return true;
 }
 
-std::vector<std::string_view> Tokens(std::string_view line) {
-  std::vector<std::string_view> tokens;
-  size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-    size_t j = i;
-    while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
-    if (j > i) tokens.push_back(line.substr(i, j - i));
-    i = j;
-  }
-  return tokens;
-}
-
 bool ParseScalarType(std::string_view name, ScalarType* type) {
   for (const ScalarTypeName& entry : kScalarTypeNames)
     if (name == entry.name) {
@@ -127,7 +114,8 @@ std::string ScalarTypeError(std::string_view name) {
 Header ParseHeader(const std::string& bytes, const std::string& source) {
   size_t pos = 0;
   std::string_view line;
-  if (!NextLine(bytes, &pos, &line) || Tokens(line).size() != 1 || Tokens(line)[0] != "ply")
+  if (!NextLine(bytes, &pos, &line) || SplitTokens(line).size() != 1 ||
+      SplitTokens(line)[0] != "ply")
     ThrowError(source, "header line 1", "expected the magic word \"ply\" (not a PLY file)");
   Header header;
   bool have_format = false;
@@ -137,7 +125,7 @@ Header ParseHeader(const std::string& bytes, const std::string& source) {
       ThrowError(source, "header", "the file ends before \"end_header\"");
     ++line_number;
     const std::string where = "header line " + std::to_string(line_number);
-    const std::vector<std::string_view> tokens = Tokens(line);
+    const std::vector<std::string_view> tokens = SplitTokens(line);
     if (tokens.empty()) continue;
     const std::string_view keyword = tokens[0];
     if (keyword == "comment" || keyword == "obj_info") continue;
@@ -232,7 +220,7 @@ class AsciiBody {
                        std::to_string(element.count) + " " + element.name +
                        " lines the header announces");
       ++line_number_;
-      tokens_ = Tokens(line);
+      tokens_ = SplitTokens(line);
     } while (tokens_.empty());
     next_token_ = 0;
   }
@@ -240,23 +228,17 @@ class AsciiBody {
   double Scalar(ScalarType type, const std::string& property) {
     if (next_token_ >= tokens_.size())
       ThrowError(source_, Where(), "the line ends before property \"" + property + "\"");
-    std::string_view token = tokens_[next_token_++];
-    if (!token.empty() && token[0] == '+') token.remove_prefix(1);  // from_chars rejects '+'
-    const char* end = token.data() + token.size();
+    const std::string_view token = tokens_[next_token_++];
     if (IsInteger(type)) {
       long long value = 0;
-      const auto result = std::from_chars(token.data(), end, value);
-      if (result.ec != std::errc() || result.ptr != end)
+      if (!ParseInteger(token, &value))
         ThrowError(
             source_, Where(),
             "property \"" + property + "\": \"" + std::string(token) + "\" is not an integer");
       return static_cast<double>(value);
     }
     double value = 0.0;
-    const auto result = std::from_chars(token.data(), end, value);
-    if (result.ec == std::errc::result_out_of_range)
-      return std::copysign(HUGE_VAL, token[0] == '-' ? -1 : 1);
-    if (result.ec != std::errc() || result.ptr != end)
+    if (!ParseDouble(token, &value))
       ThrowError(source_, Where(),
                  "property \"" + property + "\": \"" + std::string(token) + "\" is not a number");
     // A float property holds a float: round as a binary file would have stored it.
@@ -274,7 +256,7 @@ class AsciiBody {
     std::string_view line;
     while (NextLine(bytes_, &pos_, &line)) {
       ++line_number_;
-      if (!Tokens(line).empty())
+      if (!SplitTokens(line).empty())
         ThrowError(
             source_, "line " + std::to_string(line_number_),
             "data after the last element (the header's element counts do not match the data)");

@@ -318,6 +318,28 @@ TEST_F(MeshIo, BadObjFilesNameTheLineAndTheFace) {
   ExpectReadError(WriteFile("empty.obj", "# nothing\n"), {"no \"v\" statement"});
 }
 
+// Text numbers outside double's range: 1e400 overflows to infinity (rejected as a
+// coordinate), 1e-400 underflows to 0 (accepted), in both text formats; a number with
+// trailing characters is not a number. Exact comparisons: 0 is what strtod gives.
+TEST_F(MeshIo, TextNumbersOverflowToInfinityAndUnderflowToZero) {
+  const TriangleMesh obj =
+      ReadMesh(WriteFile("tiny.obj", "v 0 0 1e-400\nv 1 0 0\nv 0 1 -1e-400\nf 1 2 3\n"));
+  EXPECT_EQ(obj.V(0, 2), 0.0);
+  EXPECT_EQ(obj.V(2, 2), 0.0);
+  ExpectReadError(WriteFile("huge.obj", "v 0 0 0\nv 1 1e400 0\nv 1 1 0\nf 1 2 3\n"),
+                  {"line 2 (vertex 1)", "coordinate y is infinite"});
+  const std::string faces = "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n";
+  const TriangleMesh ply = ReadMesh(
+      WriteFile("tiny.ply", std::string(kAsciiHeader) + "0 0 1e-400\n1 0 0\n0 1 0\n0 0 1\n" + faces));
+  EXPECT_EQ(ply.V(0, 2), 0.0);
+  ExpectReadError(
+      WriteFile("huge.ply", std::string(kAsciiHeader) + "0 0 0\n1 0 0\n0 1 1e400\n0 0 1\n" + faces),
+      {"vertex 2", "infinite"});
+  ExpectReadError(
+      WriteFile("trailing.ply", std::string(kAsciiHeader) + "0 0 0\n1e999x 0 0\n0 1 0\n0 0 1\n" + faces),
+      {"vertex 1", "is not a number"});
+}
+
 TEST_F(MeshIo, NonManifoldInputIsRejectedUnlessAllowed) {
   const std::string header5 =
       "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float "
