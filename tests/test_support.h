@@ -70,7 +70,9 @@ struct CommandResult {
   std::string output() const { return out + err; }  // both streams, stdout first
 };
 
-// SUBFLOW_BINARY, the path of the built `subflow`, comes from tests/CMakeLists.txt.
+// SUBFLOW_BINARY, the path of the built `subflow`, is defined only for the test files
+// that run it (tests/cli/ and SUBFLOW_COMMAND_TESTS in tests/CMakeLists.txt), which also
+// depend on the binary so that building them brings it up to date.
 #ifdef SUBFLOW_BINARY
 // Runs `subflow ARGUMENTS` through the shell (the caller quotes paths in ARGUMENTS) and
 // captures stdout and stderr, through the files stdout and stderr in `scratch`.
