@@ -1,6 +1,7 @@
 #include "geometry/point_stencil.h"
 
 #include <algorithm>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -61,19 +62,41 @@ void PointStencil::Apply(const Positions& x, Positions* y) const {
   y->resize(rows(), 3);
   const double* in = x.data();
   double* out = y->data();
-  ForEachRowBlock(rows(), [&](int begin, int end) {
+  // Rows of 4 and 7 entries (interior odd and regular even vertices of Loop's refinement,
+  // almost every row) get fixed-length loops the compiler unrolls; the sums are the
+  // general loop's, in its order.
+  const auto apply_rows = [&](auto entries, int begin, int end) {
     for (int row = begin; row < end; ++row) {
       const double* w = weights_.data() + weight_offsets_[row];
+      const int* column = columns_.data() + offsets_[row];
+      const int count = decltype(entries)::value > 0 ? decltype(entries)::value
+                                                     : offsets_[row + 1] - offsets_[row];
       double sx = 0.0, sy = 0.0, sz = 0.0;
-      for (int i = offsets_[row]; i < offsets_[row + 1]; ++i, ++w) {
-        const double* p = in + 3 * static_cast<Eigen::Index>(columns_[i]);
-        sx += *w * p[0];
-        sy += *w * p[1];
-        sz += *w * p[2];
+      for (int i = 0; i < count; ++i) {
+        const double* p = in + 3 * static_cast<Eigen::Index>(column[i]);
+        sx += w[i] * p[0];
+        sy += w[i] * p[1];
+        sz += w[i] * p[2];
       }
       out[3 * row] = sx;
       out[3 * row + 1] = sy;
       out[3 * row + 2] = sz;
+    }
+  };
+  ForEachRowBlock(rows(), [&](int begin, int end) {
+    int row = begin;
+    while (row < end) {
+      // A run of rows with the same length.
+      const int length = offsets_[row + 1] - offsets_[row];
+      int run_end = row + 1;
+      while (run_end < end && offsets_[run_end + 1] - offsets_[run_end] == length) ++run_end;
+      if (length == 4)
+        apply_rows(std::integral_constant<int, 4>(), row, run_end);
+      else if (length == 7)
+        apply_rows(std::integral_constant<int, 7>(), row, run_end);
+      else
+        apply_rows(std::integral_constant<int, 0>(), row, run_end);
+      row = run_end;
     }
   });
 }
