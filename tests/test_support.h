@@ -9,8 +9,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
+
+#include "geometry/triangle_mesh.h"
 
 namespace subflow::test {
 
@@ -91,5 +94,17 @@ inline CommandResult RunSubflow(const std::string& arguments,
   return run;
 }
 #endif
+
+// `mesh` with every vertex coordinate moved by a uniform random offset in
+// [−amplitude, amplitude] (std::mt19937 seeded with `seed`, so reproducible): generic
+// geometry, so that no symmetry hides a wrong weight or index.
+inline geometry::TriangleMesh Perturbed(geometry::TriangleMesh mesh, double amplitude,
+                                        unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> offset(-amplitude, amplitude);
+  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
+    for (int k = 0; k < 3; ++k) mesh.V(v, k) += offset(random);
+  return mesh;
+}
 
 }  // namespace subflow::test

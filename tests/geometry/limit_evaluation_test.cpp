@@ -28,6 +28,7 @@
 #include "geometry/loop_box_spline.h"
 #include "geometry/mesh_primitives.h"
 #include "geometry/mesh_topology.h"
+#include "tests/test_support.h"
 
 namespace subflow::geometry {
 namespace {
@@ -42,13 +43,7 @@ constexpr double kPi = 3.14159265358979323846;
 // or index moves a point by ≥ 1e-4.
 constexpr double kExact = 1e-12;
 
-TriangleMesh Perturbed(TriangleMesh mesh, unsigned seed) {
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> offset(-0.1, 0.1);
-  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
-    for (int k = 0; k < 3; ++k) mesh.V(v, k) += offset(random);
-  return mesh;
-}
+using test::Perturbed;
 
 // CGAL's Loop subdivision: levels[0] = mesh, levels[l] = l steps (old vertices keep their
 // indices; CGAL appends one vertex per edge).
@@ -142,12 +137,12 @@ struct Case {
 };
 
 std::vector<Case> Cases() {
-  return {{"tetrahedron (valence 3)", Perturbed(Tetrahedron(), 1)},
-          {"octahedron (valence 4)", Perturbed(Octahedron(), 2)},
-          {"icosahedron (valence 5)", Perturbed(Icosahedron(), 3)},
-          {"bipyramid 7 (valences 7, 4)", Perturbed(Bipyramid(7), 4)},
-          {"bipyramid 9 (valences 9, 4)", Perturbed(Bipyramid(9), 5)},
-          {"open grid (boundary, valences 4, 8)", Perturbed(GridPatch(3, 3), 6)}};
+  return {{"tetrahedron (valence 3)", Perturbed(Tetrahedron(), 0.1, 1)},
+          {"octahedron (valence 4)", Perturbed(Octahedron(), 0.1, 2)},
+          {"icosahedron (valence 5)", Perturbed(Icosahedron(), 0.1, 3)},
+          {"bipyramid 7 (valences 7, 4)", Perturbed(Bipyramid(7), 0.1, 4)},
+          {"bipyramid 9 (valences 9, 4)", Perturbed(Bipyramid(9), 0.1, 5)},
+          {"open grid (boundary, valences 4, 8)", Perturbed(GridPatch(3, 3), 0.1, 6)}};
 }
 
 // (u, v) of the point at fraction t along half-edge h of its face.
@@ -244,7 +239,7 @@ TEST(LoopLimitEvaluator, CornersAreLimitPositionsAndCgalConvergesToThemAtLoopsRa
         }
     }
   }
-  const TriangleMesh base = Perturbed(Tetrahedron(), 7);
+  const TriangleMesh base = Perturbed(Tetrahedron(), 0.1, 7);
   const std::vector<TriangleMesh> levels = CgalLevels(base, 8);
   const MeshTopology topology(base.F, 4);
   const LoopLimitEvaluator evaluator(topology);

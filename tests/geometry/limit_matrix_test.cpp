@@ -19,19 +19,14 @@
 #include "geometry/limit_tessellation.h"
 #include "geometry/mesh_primitives.h"
 #include "geometry/mesh_topology.h"
+#include "tests/test_support.h"
 
 namespace subflow::geometry {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-TriangleMesh Perturbed(TriangleMesh mesh, unsigned seed) {
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> offset(-0.1, 0.1);
-  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
-    for (int k = 0; k < 3; ++k) mesh.V(v, k) += offset(random);
-  return mesh;
-}
+using test::Perturbed;
 
 // 1→4 split of every face (edge midpoints, perturbed): old vertices keep their valence,
 // new ones have valence 6, so extraordinary vertices become isolated.
@@ -52,7 +47,7 @@ TriangleMesh MidpointSplit(const TriangleMesh& mesh, unsigned seed) {
     split.F.row(4 * f + 2) << ca, bc, c;
     split.F.row(4 * f + 3) << ab, bc, ca;
   }
-  return Perturbed(split, seed);
+  return Perturbed(split, 0.1, seed);
 }
 
 // The first four have isolated extraordinary vertices of valence 3, 4, 7 (and 4), 9 (and
@@ -61,7 +56,7 @@ TriangleMesh MidpointSplit(const TriangleMesh& mesh, unsigned seed) {
 std::vector<TriangleMesh> Meshes() {
   return {MidpointSplit(Tetrahedron(), 1), MidpointSplit(Octahedron(), 2),
           MidpointSplit(Bipyramid(7), 3),  MidpointSplit(Bipyramid(9), 4),
-          Perturbed(Bipyramid(8), 5),      Perturbed(GridPatch(3, 3), 6)};
+          Perturbed(Bipyramid(8), 0.1, 5), Perturbed(GridPatch(3, 3), 0.1, 6)};
 }
 constexpr int kIsolatedMeshCount = 4;
 
@@ -222,7 +217,8 @@ TEST(LoopLimitEvaluator, NormalsNearExtraordinaryCornersConvergeToTheLimitNormal
 }
 
 TEST(TessellateLimitSurface, IsAWatertightMeshWithTheControlMeshTopology) {
-  for (const TriangleMesh& mesh : {Perturbed(MakeIcosphere(1), 7), Perturbed(GridPatch(3, 2), 8)}) {
+  for (const TriangleMesh& mesh :
+       {Perturbed(MakeIcosphere(1), 0.1, 7), Perturbed(GridPatch(3, 2), 0.1, 8)}) {
     const int n = static_cast<int>(mesh.V.rows());
     const MeshTopology topology(mesh.F, n);
     const LoopLimitEvaluator evaluator(topology);

@@ -14,17 +14,12 @@
 #include "geometry/icosphere.h"
 #include "geometry/local_frames.h"
 #include "geometry/mesh_primitives.h"
+#include "tests/test_support.h"
 
 namespace subflow::geometry {
 namespace {
 
-TriangleMesh Perturbed(TriangleMesh mesh, double amplitude, unsigned seed) {
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> offset(-amplitude, amplitude);
-  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
-    for (int k = 0; k < 3; ++k) mesh.V(v, k) += offset(random);
-  return mesh;
-}
+using test::Perturbed;
 
 // Half-disk fan: centre 0 on the boundary with `faces` triangles, rim 1..faces+1.
 TriangleMesh HalfFan(int faces) {

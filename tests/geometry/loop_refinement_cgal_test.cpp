@@ -17,6 +17,7 @@
 #include "geometry/icosphere.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/mesh_primitives.h"
+#include "tests/test_support.h"
 
 namespace subflow::geometry {
 namespace {
@@ -31,13 +32,7 @@ constexpr double kTolerance = 1e-12;
 
 // Generic (non-symmetric) geometry, so that no two refined vertices coincide and a
 // wrong stencil cannot hide behind symmetry.
-TriangleMesh Perturbed(TriangleMesh mesh, double amplitude, unsigned seed) {
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> offset(-amplitude, amplitude);
-  for (Eigen::Index v = 0; v < mesh.V.rows(); ++v)
-    for (int k = 0; k < 3; ++k) mesh.V(v, k) += offset(random);
-  return mesh;
-}
+using test::Perturbed;
 
 SurfaceMesh ToSurfaceMesh(const TriangleMesh& mesh) {
   SurfaceMesh surface;
