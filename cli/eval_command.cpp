@@ -5,9 +5,19 @@
 #include <memory>
 #include <string>
 
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
 #include "geometry/error.h"
+#include "geometry/mesh_io.h"
+#include "solver/rigid_motion.h"
+#include "vision/dataset.h"
 #include "vision/evaluation.h"
 
 namespace subflow::cli {
@@ -18,18 +28,79 @@ struct EvalSettings {
   vision::EvaluationOptions options;
 };
 
+Eigen::Matrix3d CayleyRotation(const Eigen::Vector3d& w) {
+  Eigen::Matrix3d W;
+  W << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  return (I - 0.5 * W).inverse() * (I + 0.5 * W);
+}
+
+double RotationAngleDegrees(const Eigen::Matrix3d& R) {
+  return std::acos(std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// The rigid motion of every frame step fitted to the true vertices (the ground truth keeps
+// its connectivity) and to the result's vertices and their motion (vx vy vz), and the
+// angle between the two rotations: how well the rigid part of the motion is recovered.
+// Empty when the ground truth changes its vertex count.
+nlohmann::json RigidComparison(const std::string& dataset_directory, const std::string& result_directory) {
+  namespace fs = std::filesystem;
+  int first = 0;
+  const std::vector<std::string> result_paths =
+      vision::ListFrameMeshes((fs::path(result_directory) / "meshes").string(), &first);
+  const std::vector<std::string> truth_paths =
+      vision::ListFrameMeshes((fs::path(dataset_directory) / "groundtruth" / "mesh").string());
+  geometry::MeshReadOptions read_options;
+  read_options.require_manifold = false;
+  nlohmann::json steps = nlohmann::json::array();
+  for (std::size_t i = 0; i + 1 < result_paths.size(); ++i) {
+    const geometry::TriangleMesh t0 = geometry::ReadMesh(truth_paths.at(first + i), read_options);
+    const geometry::TriangleMesh t1 = geometry::ReadMesh(truth_paths.at(first + i + 1), read_options);
+    if (t0.V.rows() != t1.V.rows()) return nlohmann::json::array();
+    geometry::VertexProperties properties;
+    const geometry::TriangleMesh r0 = geometry::ReadMesh(result_paths[i], read_options, &properties);
+    if (!properties.values.count("vx")) return nlohmann::json::array();
+    geometry::Positions motion(r0.V.rows(), 3);
+    motion.col(0) = properties.values.at("vx");
+    motion.col(1) = properties.values.at("vy");
+    motion.col(2) = properties.values.at("vz");
+    const solver::RigidMotion truth = solver::FitRigidMotion((t0.V + t1.V) / 2.0, t1.V - t0.V);
+    const solver::RigidMotion result = solver::FitRigidMotion(r0.V + motion / 2.0, motion);
+    const Eigen::Matrix3d Rt = CayleyRotation(truth.omega), Rr = CayleyRotation(result.omega);
+    steps.push_back({{"frame", first + static_cast<int>(i)},
+                     {"true_rotation_degrees", RotationAngleDegrees(Rt)},
+                     {"rotation_degrees", RotationAngleDegrees(Rr)},
+                     {"rotation_error_degrees", RotationAngleDegrees(Rr * Rt.transpose())},
+                     {"true_non_rigid_rms", truth.rms_residual},
+                     {"non_rigid_rms", result.rms_residual}});
+  }
+  return steps;
+}
+
 void RunEval(const EvalSettings& settings) {
   ProgressBar progress;
   const vision::EvaluationReport report =
       vision::EvaluateReconstruction(settings.dataset, settings.result, settings.options, &progress);
   std::cout << report.Table();
+  const nlohmann::json rigid = RigidComparison(settings.dataset, settings.result);
+  if (!rigid.empty()) {
+    double worst = 0.0, sum = 0.0;
+    for (const auto& step : rigid) {
+      worst = std::max(worst, step["rotation_error_degrees"].get<double>());
+      sum += step["rotation_error_degrees"].get<double>();
+    }
+    std::printf("rigid motion per step: rotation error mean %.4f deg, max %.4f deg (%zu steps)\n",
+                sum / rigid.size(), worst, rigid.size());
+  }
   std::cout.flush();
   if (!settings.json_path.empty()) {
     const std::string temporary = settings.json_path + ".tmp";
     {
       std::ofstream file(temporary);
       if (!file) ThrowError(settings.json_path, "", "cannot write");
-      file << report.Json() << "\n";
+      nlohmann::json json = nlohmann::json::parse(report.Json());
+      json["rigid_motion"] = rigid;
+      file << json.dump(2) << "\n";
       if (!file) ThrowError(settings.json_path, "", "cannot write");
     }
     if (std::rename(temporary.c_str(), settings.json_path.c_str()) != 0)

@@ -81,6 +81,7 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   report["command"] = arguments.no_refine ? "reconstruct --no-refine" : "reconstruct";
   report["output"] = arguments.out;
   report["motion_init"] = MotionInitJson(options.motion, result.motion, result.first_frame);
+  if (result.retrack) report["retrack"] = MotionInitJson(options.motion, *result.retrack, result.first_frame);
   if (result.refinement) report["refinement"] = RefinementJson(options.refinement, *result.refinement, result.first_frame);
   report["rigid_motion"] = RigidMotionJson(result.rigid, result.first_frame);
   double mean_flow = 0, mean_non_rigid = 0;
@@ -96,6 +97,7 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   report["timings_seconds"] = {{"shape_init", result.shape_seconds},
                                {"motion_init", result.motion_seconds},
                                {"refinement", result.refinement_seconds},
+                               {"retrack", result.retrack_seconds},
                                {"rigid_split", result.analysis_seconds},
                                {"writing", write_seconds},
                                {"total", total}};
@@ -103,9 +105,10 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   solver::WriteJsonFile((std::filesystem::path(arguments.out) / "report.json").string(), report);
 
   spdlog::info("reconstruct: {} frames, {} vertices per frame, mean flow {:.4g} per step "
-               "(non-rigid {:.4g}); shape {:.1f} s, motion {:.1f} s, refinement {:.1f} s, total {:.1f} s",
+               "(non-rigid {:.4g}); shape {:.1f} s, motion {:.1f} s, refinement {:.1f} s, retrack {:.1f} s, "
+               "total {:.1f} s",
                frames, surfaces.front().rows(), mean_flow, mean_non_rigid, result.shape_seconds,
-               result.motion_seconds, result.refinement_seconds, total);
+               result.motion_seconds, result.refinement_seconds, result.retrack_seconds, total);
 }
 
 }  // namespace
@@ -121,6 +124,11 @@ Command AddReconstructCommand(CLI::App& app) {
   sub->add_flag("--overwrite", arguments->overwrite, "Write into a non-empty output directory");
   sub->add_flag("--no-refine", arguments->no_refine,
                 "Stop after motion initialization (no spatio-temporal stereo refinement)");
+  sub->add_flag("!--no-retrack", arguments->options.retrack,
+                "Keep the first motion pass (do not re-estimate trajectories on the refined shapes)");
+  sub->add_option("--retrack-weight", arguments->options.retrack_weight,
+                  "Blend of the second motion pass towards each frame's refined surface (0..1)")
+      ->capture_default_str();
   AddShapeInitOptions(sub, &arguments->options.shape, &arguments->evidence);
   AddMotionInitOptions(sub, &arguments->options.motion);
   AddRefinementOptions(sub, &arguments->options.refinement);

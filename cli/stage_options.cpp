@@ -46,6 +46,8 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
                   "Ceres linear solver: sparse_normal_cholesky, cgnr, iterative_schur, sparse_schur")
       ->capture_default_str();
   sub->add_option("--threads", o->threads, "Ceres threads (0 = all cores)")->capture_default_str();
+  sub->add_option("--samples-per-pixel", o->samples_per_pixel,
+                  "Surface samples per pixel² of a patch's finest view")->capture_default_str();
   sub->add_option("--max-cameras", o->max_cameras, "Best-facing cameras paired per patch")
       ->capture_default_str();
   sub->add_option("--temporal-weight", o->temporal_weight,

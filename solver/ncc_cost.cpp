@@ -42,7 +42,7 @@ Eigen::Vector3d SamplePosition(const Eigen::Vector3d& base, const double* weight
 
 void SampleView(const PatchView& view, const PatchStencil& stencil, int dof,
                 double const* const* parameters, Eigen::VectorXd* intensities,
-                Eigen::MatrixXd* jacobian, const std::vector<int>* rows) {
+                RowJacobian* jacobian, const std::vector<int>* rows) {
   const int m = static_cast<int>(stencil.rows());
   const int support = static_cast<int>(stencil.cols());
   // Displacement of each support vertex, B_j e_j (support × 3).
@@ -55,17 +55,24 @@ void SampleView(const PatchView& view, const PatchStencil& stencil, int dof,
     moved.row(j) = delta.transpose();
   }
   intensities->setZero(m);
-  if (jacobian) jacobian->setZero(m, support * dof);
+  if (jacobian) {
+    jacobian->resize(m, support * dof);
+    if (!rows) jacobian->setZero();
+    else for (int k : *rows) jacobian->row(k).setZero();
+  }
   auto sample = [&](int k) {
     const Eigen::Vector3d X = view.base[k] + (stencil.row(k) * moved).transpose();
     Eigen::Vector2d gradient;
     (*intensities)(k) = SampleClamped(*view.image, view.camera->ProjectUndistorted(X), &gradient);
     if (!jacobian || gradient.isZero()) return;
     const Eigen::RowVector3d g = gradient.transpose() * view.camera->ProjectionJacobian(X);
+    double* row = jacobian->row(k).data();
+    const double* weights = stencil.row(k).data();
     for (int j = 0; j < support; ++j) {
-      const double w = stencil(k, j);
+      const double w = weights[j];
       if (w == 0.0) continue;
-      for (int d = 0; d < dof; ++d) (*jacobian)(k, j * dof + d) = w * g.dot(view.basis[j].col(d));
+      const Eigen::Matrix3d& B = view.basis[j];
+      for (int d = 0; d < dof; ++d) row[j * dof + d] = w * (g(0) * B(0, d) + g(1) * B(1, d) + g(2) * B(2, d));
     }
   };
   if (rows) {
@@ -79,7 +86,7 @@ namespace {
 
 // In-place form of NormalizeIntensities: x becomes x̂, J becomes ∂x̂/∂θ (no allocation
 // once the thread's scratch vectors have grown to size).
-void NormalizeInPlace(Eigen::VectorXd& x, double epsilon, Eigen::MatrixXd* J) {
+void NormalizeInPlace(Eigen::VectorXd& x, double epsilon, RowJacobian* J) {
   const double m = static_cast<double>(x.size());
   x.array() -= x.mean();
   const double sigma = std::sqrt(x.squaredNorm() + m * epsilon * epsilon);
@@ -101,7 +108,7 @@ void NormalizeInPlace(Eigen::VectorXd& x, double epsilon, Eigen::MatrixXd* J) {
 }  // namespace
 
 Eigen::VectorXd NormalizeIntensities(const Eigen::VectorXd& x, double epsilon,
-                                     Eigen::MatrixXd* d_normalized) {
+                                     RowJacobian* d_normalized) {
   Eigen::VectorXd normalized = x;
   NormalizeInPlace(normalized, epsilon, d_normalized);
   return normalized;
@@ -168,9 +175,9 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
   const int columns = static_cast<int>(stencil_.cols()) * dof_;
   // Per-thread scratch: Ceres evaluates blocks concurrently, and this is the hot path.
   thread_local std::vector<Eigen::VectorXd> intensities;
-  thread_local std::vector<Eigen::MatrixXd> view_jacobians;
+  thread_local std::vector<RowJacobian> view_jacobians;
   thread_local Eigen::VectorXd xa, xb;
-  thread_local Eigen::MatrixXd ja, jb;
+  thread_local RowJacobian ja, jb;
   if (intensities.size() < views_.size()) {
     intensities.resize(views_.size());
     view_jacobians.resize(views_.size());

@@ -57,18 +57,20 @@ struct PatchView {
 // Limit-stencil weights of the samples on the patch's support vertices (m × #support,
 // dense: supports are small, 12 for a regular patch).
 using PatchStencil = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// Jacobians of intensity vectors: one row per sample (row-major, rows are gathered).
+using RowJacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 // Intensities (m) of a view at the current parameters, and ∂x/∂e (m × blocks·dof) when
 // `jacobian` is given. `parameters` are the cost's parameter blocks. When `rows` is given
 // only those samples are evaluated (the others are left at zero).
 void SampleView(const PatchView& view, const PatchStencil& stencil, int dof,
                 double const* const* parameters, Eigen::VectorXd* intensities,
-                Eigen::MatrixXd* jacobian, const std::vector<int>* rows = nullptr);
+                RowJacobian* jacobian, const std::vector<int>* rows = nullptr);
 
 // x̂ = (x − mean)/σ (see the file comment); when `d_normalized` is given, it is replaced
 // by ∂x̂/∂θ for ∂x/∂θ = *d_normalized on input (any column count).
 Eigen::VectorXd NormalizeIntensities(const Eigen::VectorXd& x, double epsilon,
-                                     Eigen::MatrixXd* d_normalized = nullptr);
+                                     RowJacobian* d_normalized = nullptr);
 
 // One correlation of a patch: views a and b compared on the samples both see.
 struct CorrelationPair {

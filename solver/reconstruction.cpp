@@ -23,6 +23,8 @@ void ReconstructionOptions::Check() const {
   shape.Check();
   motion.Check();
   if (refine) refinement.Check();
+  if (!(retrack_weight >= 0.0 && retrack_weight <= 1.0))
+    ThrowError("reconstruction options", "retrack_weight", "must be in [0, 1]");
 }
 
 geometry::Positions ReconstructionResult::Surface(int i) const {
@@ -81,6 +83,15 @@ ReconstructionResult Reconstruct(const vision::Dataset& dataset, const Reconstru
                                      progress);
     result.control = result.refinement->control;
     result.refinement_seconds = SecondsSince(start);
+    if (options.retrack) {
+      start = Clock::now();
+      MotionInitOptions retrack = options.motion;
+      retrack.hull_weight = options.retrack_weight;
+      result.retrack = InitializeMotion(dataset.cameras(), frames, gray, hierarchy, result.control,
+                                        result.shape.reference_frame - first, retrack, progress);
+      result.control = result.retrack->control;
+      result.retrack_seconds = SecondsSince(start);
+    }
   }
 
   start = Clock::now();

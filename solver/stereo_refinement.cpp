@@ -504,7 +504,10 @@ void LevelRefiner::SolveWindow(int level, int dof, int w0, int w1, const LevelSa
           const Eigen::Vector2d p = cameras_[k].ProjectUndistorted(X, &depth);
           double distance = 0.0;
           if (depth <= 0 || !SampleScalar(distances[k]->distance, p, &distance)) continue;
-          if (distance < -2.0) continue;  // deep inside: the one-sided term is inactive
+          // Inside (by more than half a pixel): the one-sided term is inactive. About a
+          // quarter of a convex surface projects within 2 px of its outline in a camera, so
+          // a wider band would cost many blocks for nothing.
+          if (distance < -0.5) continue;
           std::vector<double*> blocks;
           blocks_of(t, support, &blocks);
           auto* cost = new SilhouetteCost(distances[k].get(), &cameras_[k], X,
@@ -672,6 +675,37 @@ void LevelRefiner::SolveWindow(int level, int dof, int w0, int w1, const LevelSa
   }
 }
 
+// The finest level whose faces' median largest projected area (over the cameras facing
+// them) is at least `min_area` pixels²; level 0 when none is. Areas shrink 4× per level.
+int AutomaticFinestLevel(const LoopHierarchy& hierarchy, const Positions& finest_control,
+                         const std::vector<vision::Camera>& cameras, double min_area) {
+  const Positions base = geometry::MultiresShape::Analyze(hierarchy, finest_control).base();
+  const Positions corners = hierarchy.LimitPositions(0) * base;
+  const geometry::Faces& F = hierarchy.LevelFaces(0);
+  std::vector<double> areas;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d X0 = corners.row(F(f, 0)), X1 = corners.row(F(f, 1)), X2 = corners.row(F(f, 2));
+    const Eigen::Vector3d normal = (X1 - X0).cross(X2 - X0);
+    double largest = 0.0;
+    for (const vision::Camera& camera : cameras) {
+      if (normal.dot(camera.Center() - (X0 + X1 + X2) / 3.0) <= 0.0) continue;
+      const Eigen::Vector2d a = camera.ProjectUndistorted(X1) - camera.ProjectUndistorted(X0);
+      const Eigen::Vector2d b = camera.ProjectUndistorted(X2) - camera.ProjectUndistorted(X0);
+      largest = std::max(largest, 0.5 * std::abs(a.x() * b.y() - a.y() * b.x()));
+    }
+    if (largest > 0.0) areas.push_back(largest);
+  }
+  if (areas.empty()) return 0;
+  std::nth_element(areas.begin(), areas.begin() + areas.size() / 2, areas.end());
+  double area = areas[areas.size() / 2];
+  int level = 0;
+  while (level < hierarchy.finest_level() && area / 4.0 >= min_area) {
+    area /= 4.0;
+    ++level;
+  }
+  return level;
+}
+
 }  // namespace
 
 void StereoRefinementOptions::Check() const {
@@ -695,6 +729,7 @@ void StereoRefinementOptions::Check() const {
   require(temporal_weight >= 0 && silhouette_weight >= 0 && membrane_weight >= 0 &&
               temporal_smoothness >= 0 && damping >= 0,
           "weights", "must be ≥ 0");
+  require(min_patch_area > 0, "min_patch_area", "must be > 0 (pixels²)");
   require(angle_weight_power >= 0, "angle_weight_power", "must be ≥ 0");
   require(outline_margin >= 0, "outline_margin", "must be ≥ 0 (pixels)");
   require(max_step > 0, "max_step", "must be > 0");
@@ -719,7 +754,9 @@ RefinementResult RefineStereo(const std::vector<vision::Camera>& cameras,
                  "must have #V(finest) = " + std::to_string(hierarchy.VertexCount(hierarchy.finest_level())) +
                      " finite rows");
   const int finest_refined =
-      options.finest_level < 0 ? std::max(0, hierarchy.finest_level() - 1) : options.finest_level;
+      options.finest_level >= 0
+          ? options.finest_level
+          : AutomaticFinestLevel(hierarchy, control[control.size() / 2], cameras, options.min_patch_area);
   if (finest_refined > hierarchy.finest_level() || options.coarsest_level > finest_refined)
     ThrowError("stereo refinement options", "coarsest_level/finest_level",
                "must satisfy coarsest ≤ finest ≤ " + std::to_string(hierarchy.finest_level()));

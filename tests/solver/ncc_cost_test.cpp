@@ -107,7 +107,7 @@ TEST(NormalizeIntensities, ZeroMeanUnitNormAndExactDerivative) {
   EXPECT_LT((NormalizeIntensities(3.0 * x.array() + 0.7, 0.0) - n).norm(), 1e-14);
 
   for (double epsilon : {0.0, 0.05}) {
-    Eigen::MatrixXd J = Eigen::MatrixXd::Identity(6, 6);
+    RowJacobian J = RowJacobian::Identity(6, 6);
     const Eigen::VectorXd base = NormalizeIntensities(x, epsilon, &J);
     for (int i = 0; i < 6; ++i) {
       Eigen::VectorXd xp = x, xm = x;

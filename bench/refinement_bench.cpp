@@ -1,0 +1,105 @@
+// The Ceres linear solver of the stereo refinement, chosen by measurement on our real
+// problem: the blob dataset (10 cameras, 320×240), frames 10–12 refined jointly (one
+// window), levels 0–2 (normal-only increments, 400 → 6,400 patches), one round per level,
+// starting from the pipeline's own shape and motion initialization (computed once).
+//
+// Per solver: wall time of RefineStereo, time inside ceres::Solve, Ceres iterations,
+// mean NCC after refinement and the mean distance of the output surface (limit positions
+// of the finest vertices) to the ground truth. Run with
+//   refinement_bench --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+// Threads: SUBFLOW_BENCH_THREADS (default: all cores).
+#include <cstdlib>
+
+#include <benchmark/benchmark.h>
+
+#include "geometry/closest_point.h"
+#include "geometry/mesh_io.h"
+#include "solver/motion_init.h"
+#include "solver/reconstruction.h"
+#include "solver/shape_init.h"
+#include "solver/stereo_refinement.h"
+#include "vision/dataset.h"
+
+namespace {
+
+using namespace subflow;
+using geometry::Positions;
+
+constexpr int kFirstFrame = 10, kFrames = 3;
+
+struct Initialized {
+  vision::Dataset dataset{SUBFLOW_SHARED_DIR "/data/blob"};
+  solver::ShapeInitResult shape;
+  std::vector<Positions> control;
+  std::vector<geometry::ClosestPointTree> truth;
+
+  Initialized() {
+    solver::ShapeInitOptions options;
+    options.first_frame = kFirstFrame;
+    options.frame_count = kFrames;
+    shape = solver::InitializeShape(dataset, options);
+    const int finest = shape.hierarchy->finest_level();
+    std::vector<Positions> fitted;
+    for (const auto& frame : shape.frames) fitted.push_back(frame.control.at(finest));
+    control = solver::InitializeMotion(dataset.cameras(), kFrames, Gray(), *shape.hierarchy, fitted,
+                                       shape.reference_frame - kFirstFrame, {})
+                  .control;
+    for (int f = 0; f < kFrames; ++f)
+      truth.emplace_back(geometry::ReadMesh(dataset.GroundTruthMeshPath(kFirstFrame + f)), "ground truth");
+  }
+  solver::GrayImageLoader Gray() const {
+    return [this](int camera, int frame) { return dataset.Gray(camera, kFirstFrame + frame); };
+  }
+  double MeanDistanceToTruth(const std::vector<Positions>& result) const {
+    const geometry::LoopHierarchy& h = *shape.hierarchy;
+    double sum = 0.0;
+    Eigen::Index count = 0;
+    for (int f = 0; f < kFrames; ++f) {
+      const Positions surface = h.LimitPositions(h.finest_level()) * result[f];
+      for (Eigen::Index i = 0; i < surface.rows(); ++i, ++count)
+        sum += (truth[f].Closest(surface.row(i).transpose()).point - surface.row(i).transpose()).norm();
+    }
+    return sum / static_cast<double>(count);
+  }
+};
+
+const Initialized& State() {
+  static const Initialized state;
+  return state;
+}
+
+void BM_Refinement(benchmark::State& bench, const char* solver) {
+  const Initialized& s = State();
+  solver::StereoRefinementOptions options;
+  options.linear_solver = solver;
+  options.rounds = 1;
+  options.window = kFrames;
+  if (const char* env = std::getenv("SUBFLOW_BENCH_THREADS")) options.threads = std::atoi(env);
+  solver::RefinementResult result;
+  for (auto _ : bench) {
+    result = solver::RefineStereo(s.dataset.cameras(), s.Gray(), solver::SilhouetteLoader(s.dataset, s.shape),
+                                  *s.shape.hierarchy, s.control, s.dataset.bounds(), options);
+  }
+  double solver_seconds = 0, iterations = 0, ncc = 0;
+  for (const auto& level : result.levels) {
+    solver_seconds += level.solver_seconds;
+    iterations += level.iterations;
+  }
+  for (const auto& frame : result.frames) ncc += frame.ncc_after / kFrames;
+  bench.counters["ceres_s"] = solver_seconds;
+  bench.counters["iterations"] = iterations;
+  bench.counters["ncc_after"] = ncc;
+  bench.counters["mean_dist_mm"] = 1e3 * s.MeanDistanceToTruth(result.control);
+}
+
+BENCHMARK_CAPTURE(BM_Refinement, sparse_normal_cholesky, "sparse_normal_cholesky")
+    ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Refinement, cgnr, "cgnr")->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Refinement, iterative_schur, "iterative_schur")
+    ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Refinement, sparse_schur, "sparse_schur")
+    ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
