@@ -103,9 +103,11 @@ CollinearityResult CollinearityWeights(const NormalFlowConstraints& constraints,
     if (!tested(s)) return;
     ++tested_samples;
     std::vector<int> rows = rows_of(s);
-    std::vector<double> t;
-    while (true) {
-      DeletionResiduals(constraints, rows, &t);
+    // The first fit of all the sample's rows is the one σ came from.
+    std::vector<double> t(rows.size());
+    for (std::size_t i = 0; i < rows.size(); ++i) t[i] = first_fit[rows[i]];
+    for (bool refit = false;; refit = true) {
+      if (refit) DeletionResiduals(constraints, rows, &t);
       const auto worst = std::max_element(t.begin(), t.end());
       if (*worst <= limit) break;
       if (static_cast<int>(rows.size()) <= options.min_cameras) {

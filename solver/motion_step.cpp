@@ -88,10 +88,9 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
     const NormalFlowConstraints constraints = BuildStepConstraints(
         cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility);
     if (pass == passes - 1) {
-      // Photometric error of zero motion at the finest σ, on the same rows.
-      const NormalFlowConstraints zero = BuildStepConstraints(
-          cameras_, smoothed_before, smoothed_after, positions, Positions(), visibility);
-      step.report.photometric_rms_zero = Rms(zero.photometric);
+      // Photometric error of zero motion at the finest σ.
+      step.report.photometric_rms_zero = Rms(StepPhotometricDifferences(
+          cameras_, smoothed_before, smoothed_after, positions, Positions(), visibility));
     }
     step.solution = solver_.Solve(constraints, control, pass > 0 ? &step.solution : nullptr);
     step.displacement = step.solution.displacement;
@@ -101,9 +100,8 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
     step.report.pruned = step.solution.pruned;
     step.report.collinearity_pruned = step.solution.collinearity_pruned;
   }
-  const NormalFlowConstraints final_rows = BuildStepConstraints(
-      cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility);
-  step.report.photometric_rms = Rms(final_rows.photometric);
+  step.report.photometric_rms = Rms(StepPhotometricDifferences(
+      cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility));
   step.report.mean_displacement = step.displacement.rowwise().norm().mean();
   step.report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -1,5 +1,6 @@
 #include "solver/normal_flow_constraints.h"
 
+#include <algorithm>
 #include <functional>
 #include <string>
 
@@ -123,6 +124,48 @@ NormalFlowConstraints BuildStepConstraints(const std::vector<vision::Camera>& ca
     row->rhs = -row->photometric + row->gradient.dot(u);
     return true;
   });
+}
+
+Eigen::VectorXd StepPhotometricDifferences(const std::vector<vision::Camera>& cameras,
+                                           const std::vector<SmoothedImage>& before,
+                                           const std::vector<SmoothedImage>& after,
+                                           const geometry::Positions& sample_positions,
+                                           const geometry::Positions& sample_displacement,
+                                           const SampleVisibility& visibility) {
+  CheckCommon(cameras, before.size(), sample_positions, visibility);
+  if (after.size() != before.size())
+    ThrowError("normal flow constraints", "images", "before and after differ in camera count");
+  const bool has_guess = sample_displacement.rows() > 0;
+  if (has_guess && sample_displacement.rows() != sample_positions.rows())
+    ThrowError("normal flow constraints", "sample displacement",
+               std::to_string(sample_displacement.rows()) + " rows for " +
+                   std::to_string(sample_positions.rows()) + " samples");
+  constexpr int kChunk = 1024;
+  const int sample_count = static_cast<int>(sample_positions.rows());
+  const int chunk_count = (sample_count + kChunk - 1) / kChunk;
+  std::vector<std::vector<double>> chunks(chunk_count);
+  tbb::parallel_for(0, chunk_count, [&](int c) {
+    for (int s = c * kChunk; s < std::min(sample_count, (c + 1) * kChunk); ++s)
+      for (int k = 0; k < visibility.camera_count(); ++k) {
+        if (!visibility.visible[k][s]) continue;
+        const vision::Camera& camera = cameras[k];
+        const Eigen::Vector3d X = sample_positions.row(s).transpose();
+        const Eigen::Vector3d X_after =
+            has_guess ? Eigen::Vector3d(X + sample_displacement.row(s).transpose()) : X;
+        double depth = 0.0, i_before = 0.0, i_after = 0.0;
+        if (!SampleScalar(before[k].intensity, camera.ProjectUndistorted(X), &i_before)) continue;
+        const Eigen::Vector2d p_after = camera.ProjectUndistorted(X_after, &depth);
+        if (!(depth > 0.0) || !SampleScalar(after[k].intensity, p_after, &i_after)) continue;
+        chunks[c].push_back(i_after - i_before);
+      }
+  });
+  std::size_t total = 0;
+  for (const auto& chunk : chunks) total += chunk.size();
+  Eigen::VectorXd differences(static_cast<Eigen::Index>(total));
+  Eigen::Index i = 0;
+  for (const auto& chunk : chunks)
+    for (double d : chunk) differences(i++) = d;
+  return differences;
 }
 
 NormalFlowConstraints BuildFrameConstraints(

@@ -67,6 +67,16 @@ NormalFlowConstraints BuildStepConstraints(const std::vector<vision::Camera>& ca
                                            const geometry::Positions& sample_displacement,
                                            const SampleVisibility& visibility);
 
+// The `photometric` column alone of BuildStepConstraints for the same arguments (same
+// rows, same order), from intensities only: no gradients, no Jacobians. For reports (the
+// photometric error of a motion) at a fraction of the cost.
+Eigen::VectorXd StepPhotometricDifferences(const std::vector<vision::Camera>& cameras,
+                                           const std::vector<SmoothedImage>& before,
+                                           const std::vector<SmoothedImage>& after,
+                                           const geometry::Positions& sample_positions,
+                                           const geometry::Positions& sample_displacement,
+                                           const SampleVisibility& visibility);
+
 // Frame form (eq. 24 at one frame): one SpatioTemporalDerivatives per camera.
 NormalFlowConstraints BuildFrameConstraints(
     const std::vector<vision::Camera>& cameras,

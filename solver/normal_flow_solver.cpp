@@ -22,6 +22,10 @@ using Sparse = Eigen::SparseMatrix<double>;
 using VectorMap = Eigen::Map<Eigen::VectorXd>;
 using ConstVectorMap = Eigen::Map<const Eigen::VectorXd>;
 
+// Limit weights are O(1) (a row of L sums to 1); what the products L P_i leave of the
+// finest stencil's other ancestors cancels to ~1e-16.
+constexpr double kCancelledWeight = 1e-12;
+
 // A ⊗ I3 for a scalar sparse matrix A: entry (r, c) becomes the 3×3 block at (3r, 3c).
 template <typename Matrix>
 Sparse Kron3(const Matrix& A) {
@@ -96,42 +100,12 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   limit_ = sample_limit;
   limit_.makeCompressed();
 
-  // Pattern of Lᵀ L (all-ones values: no cancellation) and, per sample, the entry of each
-  // pair of its stencil's columns.
-  Sparse ones = limit_;
-  for (int k = 0; k < ones.outerSize(); ++k)
-    for (Sparse::InnerIterator it(ones, k); it; ++it) it.valueRef() = 1.0;
-  pattern_ = Sparse(ones.transpose() * ones);
-  // A transposed copy sorts the inner indices (the pair lookup below bisects them).
-  const Sparse pattern_transposed = pattern_.transpose();
-  pattern_ = pattern_transposed.transpose();
-  pattern_.makeCompressed();
-  const int samples = static_cast<int>(limit_.rows());
-  sample_pair_offset_.assign(samples + 1, 0);
-  for (int s = 0; s < samples; ++s) {
-    const int k = limit_.outerIndexPtr()[s + 1] - limit_.outerIndexPtr()[s];
-    sample_pair_offset_[s + 1] = sample_pair_offset_[s] + k * k;
-  }
-  pair_entry_.resize(sample_pair_offset_.back());
-  const int* outer = pattern_.outerIndexPtr();
-  const int* inner = pattern_.innerIndexPtr();
-  tbb::parallel_for(0, samples, [&](int s) {
-    const int begin = limit_.outerIndexPtr()[s], k = limit_.outerIndexPtr()[s + 1] - begin;
-    const int* columns = limit_.innerIndexPtr() + begin;
-    for (int p = 0; p < k; ++p)
-      for (int q = 0; q < k; ++q) {
-        const int* first = inner + outer[columns[q]];
-        const int* last = inner + outer[columns[q] + 1];
-        const int* found = std::lower_bound(first, last, columns[p]);
-        SUBFLOW_CHECK(found != last && *found == columns[p], "LᵀL pattern misses a pair");
-        pair_entry_[sample_pair_offset_[s] + p * k + q] = static_cast<int>(found - inner);
-      }
-  });
-
   // Prolongations P_i = C(n−1)⋯C(i), Laplacian Gram matrices, length scales.
   prolongation3_.resize(n_ + 1);
+  level_limit_.resize(n_ + 1);
   refinement3_.resize(n_ + 1);
   smoothness3_.resize(n_ + 1);
+  regularizer3_.resize(n_ + 1);
   length_ratio4_.assign(n_ + 1, 0.0);
   geometry::SparseMatrix P(vertices, vertices);
   P.setIdentity();
@@ -147,17 +121,145 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   if (!(radius > 0.0) || !(finest_edge > 0.0))
     ThrowError("normal flow solver", "reference control points", "are degenerate (zero size)");
   for (int level = n_; level >= lo_; --level) {
-    if (level < n_) {
-      P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
-      refinement3_[level] = Kron3(hierarchy.Refinement(level));
-    }
+    if (level < n_) P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
+    if (level < hi_) refinement3_[level] = Kron3(hierarchy.Refinement(level));
+    if (level == hi_) stencils_ = MakeStencils(geometry::SparseMatrix(limit_ * P));
     if (level <= hi_) {
+      if (level == hi_) {
+        level_limit_[level] = stencils_.limit;
+      } else {
+        level_limit_[level] = level_limit_[level + 1] * hierarchy.Refinement(level);
+        level_limit_[level].prune(1.0, kCancelledWeight);
+        level_limit_[level].makeCompressed();
+      }
       prolongation3_[level] = Kron3(P);
       const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(hierarchy.Topology(level));
       smoothness3_[level] = Kron3(geometry::SparseMatrix(U.transpose() * U));
       length_ratio4_[level] = std::pow(radius / (finest_edge * std::ldexp(1.0, n_ - level)), 4);
+      Sparse identity(smoothness3_[level].rows(), smoothness3_[level].cols());
+      identity.setIdentity();
+      regularizer3_[level] = options_.smoothness * length_ratio4_[level] * smoothness3_[level] +
+                             (level == lo_ ? 1e-9 : options_.detail_damping) * identity;
+      regularizer3_[level].makeCompressed();
     }
   }
+}
+
+NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
+    const geometry::SparseMatrix& limit) {
+  SampleStencils stencils;
+  stencils.limit = limit.pruned(1.0, kCancelledWeight);
+  stencils.limit.makeCompressed();
+  const geometry::SparseMatrix& L = stencils.limit;
+  // Pattern of Lᵀ L (all-ones values: no cancellation), inner indices sorted (a transposed
+  // copy sorts them; the lookups below bisect).
+  Sparse ones = L;
+  for (int k = 0; k < ones.outerSize(); ++k)
+    for (Sparse::InnerIterator it(ones, k); it; ++it) it.valueRef() = 1.0;
+  stencils.pattern = Sparse(ones.transpose() * ones);
+  const Sparse pattern_transposed = stencils.pattern.transpose();
+  stencils.pattern = pattern_transposed.transpose();
+  stencils.pattern.makeCompressed();
+  const int* outer = stencils.pattern.outerIndexPtr();
+  const int* inner = stencils.pattern.innerIndexPtr();
+  auto entry = [&](int row, int column) {
+    const int* first = inner + outer[column];
+    const int* last = inner + outer[column + 1];
+    const int* found = std::lower_bound(first, last, row);
+    SUBFLOW_CHECK(found != last && *found == row, "LᵀL pattern misses a pair");
+    return static_cast<int>(found - inner);
+  };
+  const int vertices = static_cast<int>(stencils.pattern.cols());
+  stencils.mirror.resize(static_cast<std::size_t>(stencils.pattern.nonZeros()));
+  tbb::parallel_for(0, vertices, [&](int column) {
+    for (int e = outer[column]; e < outer[column + 1]; ++e) stencils.mirror[e] = entry(column, inner[e]);
+  });
+  const int samples = static_cast<int>(L.rows());
+  stencils.sample_pair_offset.assign(samples + 1, 0);
+  for (int s = 0; s < samples; ++s) {
+    const int k = L.outerIndexPtr()[s + 1] - L.outerIndexPtr()[s];
+    stencils.sample_pair_offset[s + 1] = stencils.sample_pair_offset[s] + k * (k + 1) / 2;
+  }
+  stencils.pair_entry.resize(stencils.sample_pair_offset.back());
+  tbb::parallel_for(0, samples, [&](int s) {
+    const int begin = L.outerIndexPtr()[s], k = L.outerIndexPtr()[s + 1] - begin;
+    const int* columns = L.innerIndexPtr() + begin;
+    int* pairs = stencils.pair_entry.data() + stencils.sample_pair_offset[s];
+    for (int p = 0; p < k; ++p)
+      for (int q = p; q < k; ++q)
+        *pairs++ = entry(std::min(columns[p], columns[q]), std::max(columns[p], columns[q]));
+  });
+  return stencils;
+}
+
+NormalFlowSolver::Sparse NormalFlowSolver::DataMatrix(
+    const SampleStencils& stencils, const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M) {
+  const Sparse& pattern = stencils.pattern;
+  const geometry::SparseMatrix& L = stencils.limit;
+  const int vertices = static_cast<int>(pattern.cols());
+  const int samples = static_cast<int>(L.rows());
+  const std::size_t entries = static_cast<std::size_t>(pattern.nonZeros());
+  // Block (a, b) of N = Σ_s L_sᵀ L_s ⊗ M_s is Σ_s l_sa l_sb M_s: symmetric, and equal to
+  // block (b, a). Only the upper pattern entries (row ≤ column) accumulate, 6 values each.
+  auto add_samples = [&](int first, int last, double* sums) {
+    for (int s = first; s < last; ++s) {
+      const double* m6 = M.row(s).data();
+      if (m6[0] == 0.0 && m6[3] == 0.0 && m6[5] == 0.0) continue;
+      const int begin = L.outerIndexPtr()[s], k = L.outerIndexPtr()[s + 1] - begin;
+      const double* l = L.valuePtr() + begin;
+      const int* pairs = stencils.pair_entry.data() + stencils.sample_pair_offset[s];
+      for (int p = 0; p < k; ++p)
+        for (int q = p; q < k; ++q) {
+          const double w = l[p] * l[q];
+          double* sum = sums + 6 * static_cast<std::size_t>(*pairs++);
+          for (int i = 0; i < 6; ++i) sum[i] += w * m6[i];
+        }
+    }
+  };
+  // Parallel over a fixed split of the samples, each part into its own sums, added in
+  // part order (deterministic). The parts are few: their sums (6 per pattern entry of
+  // level hi, not the finest level) cost less than the scatter they parallelize.
+  const int part_count = std::clamp(samples / 8192, 1, 4);
+  std::vector<std::vector<double>> partial(part_count);
+  tbb::parallel_for(0, part_count, [&](int part) {
+    partial[part].assign(6 * entries, 0.0);
+    add_samples(static_cast<int>(static_cast<long>(samples) * part / part_count),
+                static_cast<int>(static_cast<long>(samples) * (part + 1) / part_count),
+                partial[part].data());
+  });
+  std::vector<double>& sums = partial[0];
+  for (int part = 1; part < part_count; ++part)
+    for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += partial[part][i];
+
+  // Interleaved (unknown 3v + axis): the block of pattern entry e (column j with m entries,
+  // its t-th) holds column 3j + b at values 9 outer[j] + 3 m b + 3 t + a (row 3 inner[e] + a).
+  const int* outer = pattern.outerIndexPtr();
+  const int* inner = pattern.innerIndexPtr();
+  Sparse N(3 * vertices, 3 * vertices);
+  N.resizeNonZeros(static_cast<Eigen::Index>(9 * entries));
+  int* N_outer = N.outerIndexPtr();
+  int* N_inner = N.innerIndexPtr();
+  double* values = N.valuePtr();
+  constexpr int kSym[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+  tbb::parallel_for(tbb::blocked_range<int>(0, vertices, 256), [&](const tbb::blocked_range<int>& range) {
+    for (int j = range.begin(); j < range.end(); ++j) {
+      const int m = outer[j + 1] - outer[j];
+      for (int b = 0; b < 3; ++b) {
+        const int start = 9 * outer[j] + 3 * m * b;
+        N_outer[3 * j + b] = start;
+        for (int t = 0; t < m; ++t) {
+          const int e = outer[j] + t;
+          const double* sum = sums.data() + 6 * static_cast<std::size_t>(inner[e] <= j ? e : stencils.mirror[e]);
+          for (int a = 0; a < 3; ++a) {
+            N_inner[start + 3 * t + a] = 3 * inner[e] + a;
+            values[start + 3 * t + a] = sum[kSym[a][b]];
+          }
+        }
+      }
+    }
+  });
+  N_outer[3 * vertices] = static_cast<int>(9 * entries);
+  return N;
 }
 
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
@@ -181,7 +283,8 @@ std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
 void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
                                    const Eigen::VectorXd& weights,
                                    const std::vector<Positions>& rigid_part,
-                                   NormalFlowSolution* solution) const {
+                                   NormalFlowSolution* solution,
+                                   Positions* sample_motion_out) const {
   const int samples = static_cast<int>(limit_.rows());
   const int vertices = static_cast<int>(limit_.cols());
   // Per-sample aggregates: M_s = Σ w g gᵀ (6 unique entries), h_s = Σ w b g.
@@ -197,70 +300,23 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
                                                 g(1) * g(1), g(1) * g(2), g(2) * g(2));
     h.row(s) += (w * constraints.rhs(c)) * g;
   }
-  // N = Σ_s L_sᵀ L_s ⊗ M_s on the finest level, interleaved (unknown 3v + axis).
-  const int* outer = pattern_.outerIndexPtr();
-  const int* inner = pattern_.innerIndexPtr();
-  Sparse N(3 * vertices, 3 * vertices);
-  N.resizeNonZeros(9 * pattern_.nonZeros());
-  for (int j = 0; j < vertices; ++j) {
-    const int m = outer[j + 1] - outer[j];
-    for (int b = 0; b < 3; ++b) {
-      const int start = 9 * outer[j] + 3 * m * b;
-      N.outerIndexPtr()[3 * j + b] = start;
-      for (int t = 0; t < m; ++t)
-        for (int a = 0; a < 3; ++a) N.innerIndexPtr()[start + 3 * t + a] = 3 * inner[outer[j] + t] + a;
-    }
-  }
-  N.outerIndexPtr()[3 * vertices] = 9 * static_cast<int>(pattern_.nonZeros());
-  double* values = N.valuePtr();
-  const std::size_t value_count = 9 * static_cast<std::size_t>(pattern_.nonZeros());
-  std::fill(values, values + value_count, 0.0);
-  // Parallel over samples, each thread into its own copy of the values, summed after.
-  tbb::enumerable_thread_specific<std::vector<double>> partial_values(
-      [&] { return std::vector<double>(value_count, 0.0); });
-  tbb::parallel_for(tbb::blocked_range<int>(0, samples, 4096), [&](const tbb::blocked_range<int>& range) {
-    double* local = partial_values.local().data();
-    for (int s = range.begin(); s < range.end(); ++s) {
-      const Eigen::Matrix<double, 1, 6> m6 = M.row(s);
-      if (m6(0) == 0.0 && m6(3) == 0.0 && m6(5) == 0.0) continue;
-      const double Ms[3][3] = {{m6(0), m6(1), m6(2)}, {m6(1), m6(3), m6(4)}, {m6(2), m6(4), m6(5)}};
-      const int begin = limit_.outerIndexPtr()[s], k = limit_.outerIndexPtr()[s + 1] - begin;
-      const int* columns = limit_.innerIndexPtr() + begin;
-      const double* l = limit_.valuePtr() + begin;
-      const int* pairs = pair_entry_.data() + sample_pair_offset_[s];
-      for (int q = 0; q < k; ++q) {
-        const int j = columns[q];
-        const int m = outer[j + 1] - outer[j];
-        for (int p = 0; p < k; ++p) {
-          const double w = l[p] * l[q];
-          double* block = local + 9 * outer[j] + 3 * (pairs[p * k + q] - outer[j]);
-          for (int b = 0; b < 3; ++b)
-            for (int a = 0; a < 3; ++a) block[3 * m * b + a] += w * Ms[a][b];
-        }
-      }
-    }
-  });
-  for (const std::vector<double>& local : partial_values)
-    for (std::size_t i = 0; i < value_count; ++i) values[i] += local[i];
-  const Positions q_positions = limit_.transpose() * h;
-  const ConstVectorMap q(q_positions.data(), 3 * vertices);
-
   solution->displacement = Positions::Zero(vertices, 3);
   VectorMap D(solution->displacement.data(), 3 * vertices);
+  Positions sample_motion = Positions::Zero(samples, 3);  // L D
   solution->level_motion.resize(n_ + 1);
   solution->levels.clear();
   Positions coarse_motion = Positions::Zero(hierarchy_->VertexCount(lo_), 3);  // W_i
-  // Data matrices of the levels, fine to coarse, one refinement step at a time:
-  // P_iᵀ N P_i = C(i)ᵀ (P_{i+1}ᵀ N P_{i+1}) C(i) (C(i) is much sparser than P_i).
+  // Data matrices of the levels: assembled on level hi, carried to the coarser ones one
+  // refinement step at a time, P_iᵀ N P_i = C(i)ᵀ (P_{i+1}ᵀ N P_{i+1}) C(i).
   std::vector<Sparse> data(n_ + 1);
-  data[n_] = std::move(N);
-  for (int level = n_ - 1; level >= lo_; --level)
+  data[hi_] = DataMatrix(stencils_, M);
+  for (int level = hi_ - 1; level >= lo_; --level)
     data[level] = Sparse(refinement3_[level].transpose() * Sparse(data[level + 1] * refinement3_[level]));
-  const Sparse& N_finest = data[n_];
   for (int level = lo_; level <= hi_; ++level) {
     const int unknowns = 3 * hierarchy_->VertexCount(level);
     const Sparse& P3 = prolongation3_[level];
-    Sparse A = data[level];
+    const geometry::SparseMatrix& level_limit = level_limit_[level];
+    Sparse A = std::move(data[level]);
     LevelSolveReport report;
     report.level = level;
     report.unknowns = unknowns;
@@ -272,16 +328,26 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
     if (report.data_stiffness > 0.0) {
       report.smoothness_weight =
           options_.smoothness * report.data_stiffness * length_ratio4_[level];
-      const double damping = (level == lo_ ? 1e-9 : options_.detail_damping) * report.data_stiffness;
       Positions smooth_about = coarse_motion;  // W_i − ρ_i
       if (rigid_part[level].rows() == smooth_about.rows()) smooth_about -= rigid_part[level];
       const ConstVectorMap W(smooth_about.data(), unknowns);
-      const Eigen::VectorXd rhs =
-          P3.transpose() * (q - N_finest * D) - report.smoothness_weight * (smoothness3_[level] * W);
-      A += report.smoothness_weight * smoothness3_[level];
-      Sparse identity(unknowns, unknowns);
-      identity.setIdentity();
-      A += damping * identity;
+      // Data part of the right-hand side: P_iᵀ (Lᵀ h − Lᵀ M L D) = L_iᵀ (h_s − M_s (L D)_s).
+      Positions sample_rhs(samples, 3);
+      tbb::parallel_for(tbb::blocked_range<int>(0, samples, 4096),
+                        [&](const tbb::blocked_range<int>& range) {
+        for (int s = range.begin(); s < range.end(); ++s) {
+          const double* m6 = M.row(s).data();
+          const double u0 = sample_motion(s, 0), u1 = sample_motion(s, 1), u2 = sample_motion(s, 2);
+          sample_rhs(s, 0) = h(s, 0) - (m6[0] * u0 + m6[1] * u1 + m6[2] * u2);
+          sample_rhs(s, 1) = h(s, 1) - (m6[1] * u0 + m6[3] * u1 + m6[4] * u2);
+          sample_rhs(s, 2) = h(s, 2) - (m6[2] * u0 + m6[4] * u1 + m6[5] * u2);
+        }
+      });
+      const Positions data_rhs = level_limit.transpose() * sample_rhs;
+      const Eigen::VectorXd rhs = ConstVectorMap(data_rhs.data(), unknowns) -
+                                  report.smoothness_weight * (smoothness3_[level] * W);
+      // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
+      A += report.data_stiffness * regularizer3_[level];
       A.makeCompressed();
       Eigen::VectorXd solution_vector = x;
       const ConjugateGradientResult cg = SolveConjugateGradient(
@@ -293,11 +359,13 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       x.setZero();
     }
     D += P3 * x;
+    sample_motion += level_limit * delta;
     solution->cg_iterations += report.cg_iterations;
     solution->levels.push_back(report);
     if (level < hi_)
       coarse_motion = hierarchy_->Refinement(level) * Positions(coarse_motion + delta);
   }
+  *sample_motion_out = std::move(sample_motion);
 }
 
 NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constraints,
@@ -327,10 +395,11 @@ NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constrai
   Eigen::VectorXd weights = solution.collinearity_weights;
   Eigen::VectorXd residual;
   Positions previous = warm_start ? warm_start->displacement : Positions();
+  Positions sample_motion;
   for (int pass = 0; pass <= options_.reweighting_iterations; ++pass) {
-    SolveLevels(constraints, weights, RigidPart(control, previous), &solution);
+    SolveLevels(constraints, weights, RigidPart(control, previous), &solution, &sample_motion);
     previous = solution.displacement;
-    residual = constraints.Residuals(SampleMotion(solution.displacement));
+    residual = constraints.Residuals(sample_motion);
     if (pass == options_.reweighting_iterations) break;
     std::vector<double> active;
     for (int c = 0; c < constraints.size(); ++c)

@@ -32,6 +32,11 @@
 //     the umbrella operator of a smooth field scales like h²·Δ, so this is
 //     smoothness · R⁴ ∫ |Δv|² per unit of data, a fixed continuous energy;
 //     μ_i = detail_damping · κ_i for i > lo, 1e−9 κ_lo on the base (definiteness only).
+// Data matrices: P_iᵀ Lᵀ M L P_i (M the per-sample 3×3 blocks Σ w g gᵀ) is assembled
+// directly on the finest ESTIMATED level hi from the samples' level-hi limit stencils
+// L P_hi, and carried to coarser levels by C(i)ᵀ · C(i); the right-hand sides are
+// (L P_i)ᵀ (h − M L D). No matrix of the finest level's size (4^{n−hi} × level hi's) is
+// assembled when hi < n.
 // Each level's normal equations are solved by preconditioned conjugate gradients
 // (conjugate_gradient.h: Eigen's iteration with a 3×3 block-Jacobi preconditioner, one
 // block per control point, and a parallel matrix–vector product), warm-started from the
@@ -143,23 +148,45 @@ class NormalFlowSolver {
   using Sparse = Eigen::SparseMatrix<double>;  // column-major, for CG and products
 
   // rigid_part[i]: ρ_i (#V(i)×3) for the estimated levels, or empty for ρ = 0.
+  // `sample_motion` receives L ∂c_n of the solution (#S×3).
   void SolveLevels(const NormalFlowConstraints& constraints, const Eigen::VectorXd& weights,
                    const std::vector<geometry::Positions>& rigid_part,
-                   NormalFlowSolution* solution) const;
+                   NormalFlowSolution* solution, geometry::Positions* sample_motion) const;
   // ρ_i of the file comment for the displacement `previous` of `control`.
   std::vector<geometry::Positions> RigidPart(const geometry::Positions& control,
                                              const geometry::Positions& previous) const;
+
+  // The samples as limit points of the finest estimated level: L_hi = L P_hi (#S × #V(hi)).
+  // The limit surface of C(i) c is that of c, so a row of L_hi is level hi's own limit
+  // stencil (the 1-ring of the face holding the sample, ~12 control points), not the union
+  // of the finest stencil's ancestors; entries that cancel to rounding noise are dropped.
+  // The data matrix is assembled there once per solve (DataMatrix) and carried to the
+  // coarser levels by C(i)ᵀ · C(i); the finest level's (#V(n) ≫ #V(hi)) is never formed.
+  struct SampleStencils {
+    geometry::SparseMatrix limit;        // L_hi, row-major
+    Sparse pattern;                      // pattern of L_hiᵀ L_hi (#V(hi) square), sorted
+    std::vector<int> mirror;             // per pattern entry (r, c): the entry (c, r)
+    // Per sample, per stencil pair p ≤ q: the pattern entry (min, max) of their columns.
+    std::vector<int> pair_entry;
+    std::vector<int> sample_pair_offset; // #S + 1 offsets into pair_entry
+  };
+  // Drops the rounding-noise entries of `limit` and builds the pair pattern.
+  static SampleStencils MakeStencils(const geometry::SparseMatrix& limit);
+  // L_hiᵀ M L_hi = P_hiᵀ (Lᵀ M L) P_hi, interleaved (unknown 3v + axis), for per-sample
+  // symmetric 3×3 blocks M (#S×6: xx xy xz yy yz zz).
+  static Sparse DataMatrix(const SampleStencils& stencils,
+                           const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M);
 
   const geometry::LoopHierarchy* hierarchy_;
   NormalFlowSolverOptions options_;
   int n_ = 0, lo_ = 0, hi_ = 0;
   geometry::SparseMatrix limit_;       // L, row-major
-  Sparse pattern_;                     // pattern of Lᵀ L (#V(n) square), values unused
-  std::vector<int> pair_entry_;        // per sample, per (p, q) stencil pair: entry of pattern_
-  std::vector<int> sample_pair_offset_;  // #S + 1 offsets into pair_entry_
+  SampleStencils stencils_;            // of level hi
+  std::vector<geometry::SparseMatrix> level_limit_;  // L P_i (#S × #V(i)), by level lo..hi
+  std::vector<Sparse> refinement3_;    // C(i) ⊗ I3 (3#V(i+1) × 3#V(i)), by level lo..hi−1
   std::vector<Sparse> prolongation3_;  // P_i ⊗ I3 (3#V(n) × 3#V(i)), by level
-  std::vector<Sparse> refinement3_;    // C(i) ⊗ I3 (3#V(i+1) × 3#V(i)), by level < n
   std::vector<Sparse> smoothness3_;    // U_iᵀ U_i ⊗ I3, by level
+  std::vector<Sparse> regularizer3_;   // smoothness (R/h_i)⁴ U_iᵀU_i ⊗ I3 + β_i I, by level
   std::vector<double> length_ratio4_;  // (R/h_i)⁴ by level
 };
 
