@@ -17,8 +17,8 @@ Command AddSynthCommand(CLI::App& app) {
   auto options = std::make_shared<vision::SynthOptions>();
   auto out = std::make_shared<std::string>();
   CLI::App* command = app.add_subcommand(
-      "synth", "Render a synthetic dataset (blob, rigid or head) with ground-truth meshes");
-  command->add_option("scene", options->scene.scene, "Scene: blob, rigid or head")
+      "synth", "Render a synthetic dataset (blob, rigid, head or sphere) with ground-truth meshes");
+  command->add_option("scene", options->scene.scene, "Scene: blob, rigid, head or sphere")
       ->required()
       ->check(CLI::IsMember(vision::SyntheticSceneNames()));
   command->add_option("--out,-o", *out, "Output dataset directory (new or empty)")->required();

@@ -109,12 +109,26 @@ SyntheticScene MakeHead(const geometry::TriangleMesh& sphere, const SyntheticSce
   return scene;
 }
 
+SyntheticScene MakeSphere(const geometry::TriangleMesh& sphere, const SyntheticSceneOptions& o) {
+  SyntheticScene scene{"sphere", sphere.F, sphere.V * 0.1, {}};
+  const Eigen::Vector3d axis = Eigen::Vector3d(-0.2, 0.4, 1.0).normalized();
+  const Eigen::Vector3d velocity = 0.0015 * Eigen::Vector3d(1.0, 0.5, -0.4).normalized();
+  for (int f = 0; f < o.frame_count; ++f) {
+    const double tau = o.motion * f;
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(2.0 * kDegree * tau, axis).toRotationMatrix();
+    Positions V = scene.rest * R.transpose();
+    V.rowwise() += (tau * velocity).transpose();
+    scene.frames.push_back(std::move(V));
+  }
+  return scene;
+}
+
 }  // namespace
 
 void SyntheticSceneOptions::Check() const {
   const auto names = SyntheticSceneNames();
   if (std::find(names.begin(), names.end(), scene) == names.end())
-    ThrowError("synthetic scene", "scene", "expected blob, rigid or head, got \"" + scene + "\"");
+    ThrowError("synthetic scene", "scene", "expected blob, rigid, head or sphere, got \"" + scene + "\"");
   if (frame_count < 1) ThrowError("synthetic scene", "frames", "expected at least 1 frame");
   if (!std::isfinite(motion) || motion < 0.0)
     ThrowError("synthetic scene", "motion", "expected a finite non-negative scale");
@@ -122,13 +136,14 @@ void SyntheticSceneOptions::Check() const {
     ThrowError("synthetic scene", "subdivisions", "expected 1..7, got " + std::to_string(subdivisions));
 }
 
-std::vector<std::string> SyntheticSceneNames() { return {"blob", "rigid", "head"}; }
+std::vector<std::string> SyntheticSceneNames() { return {"blob", "rigid", "head", "sphere"}; }
 
 SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   options.Check();
   const geometry::TriangleMesh sphere = geometry::MakeIcosphere(options.subdivisions, 1.0);
   if (options.scene == "blob") return MakeBlob(sphere, options);
   if (options.scene == "rigid") return MakeRigid(sphere, options);
+  if (options.scene == "sphere") return MakeSphere(sphere, options);
   return MakeHead(sphere, options);
 }
 

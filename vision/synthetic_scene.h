@@ -18,6 +18,12 @@
 //          brow and cheek bumps and eye dents, turning (yaw 1.2° per unit τ about +z)
 //          while a "jaw" region (front, below the mouth line) rotates open about a hinge
 //          axis parallel to x by 0.8° per unit τ, blended smoothly into the rest.
+//   sphere a round sphere r = 0.1 (the icosphere's vertices lie on it) spinning 2° per
+//          unit τ about a tilted axis through its centre and translating 1.5 mm per
+//          unit τ along (1, 0.5, −0.4)/|·|: its silhouette in any camera is known
+//          analytically (the pixels whose ray passes within r of the centre, which is
+//          the mean of the vertices), which checks the renderer and the camera
+//          convention independently of the z-buffer; and it is convex.
 #pragma once
 
 #include <string>
@@ -28,7 +34,7 @@
 namespace subflow::vision {
 
 struct SyntheticSceneOptions {
-  std::string scene = "blob";  // "blob", "rigid" or "head"
+  std::string scene = "blob";  // "blob", "rigid", "head" or "sphere"
   int frame_count = 24;        // frames 0..frame_count−1
   double motion = 1.0;         // scales the motion per frame (0 = static)
   int subdivisions = 5;        // icosphere levels: 5 → 10242 vertices, 20480 triangles
