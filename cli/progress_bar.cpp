@@ -35,6 +35,9 @@ void ProgressBar::Draw(bool final_line) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const double fraction = total_ > 0 ? static_cast<double>(done_) / total_ : 0.0;
   if (!interactive_ && !final_line) {
+    // The complete line is End's alone: printing it here too (when an Update reaches the
+    // total, or for a stage without a total) would print the stage's last line twice.
+    if (total_ == 0 || done_ >= total_) return;
     const int decile = static_cast<int>(fraction * 10);
     if (decile == last_printed_decile_) return;
     last_printed_decile_ = decile;
