@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <Eigen/Geometry>
 
@@ -114,7 +115,8 @@ inline void GatherTangents(const PointStencil& stencil, int regular_offset,
 //     like the scalar ones);
 //  3. n = c/|c|, r = t1/|t1|, q = n × r. On a degenerate lane the factors are exactly 1,
 //     so the frame is exactly (e_z, e_x, e_y), FrameFromTangentsRaw's fallback.
-inline void FramesOfBlock(int count, FrameBlock* block) {
+template <typename Block>
+inline void FramesOfBlock(int count, Block* block) {
   const double* __restrict a0 = block->a[0];
   const double* __restrict a1 = block->a[1];
   const double* __restrict a2 = block->a[2];
@@ -163,6 +165,44 @@ inline void FramesOfBlock(int count, FrameBlock* block) {
     q1[j] = n_2 * r_0 - n_0 * r_2;
     q2[j] = n_0 * r_1 - n_1 * r_0;
   }
+}
+
+// The fused step's block: FrameBlock's arrays plus the predicted points, half as long so
+// that it stays within L1 as well.
+constexpr int kFusedBlock = 128;
+
+struct FusedBlock {
+  alignas(64) double a[3][kFusedBlock];
+  alignas(64) double b[3][kFusedBlock];
+  alignas(64) double n[3][kFusedBlock];
+  alignas(64) double r[3][kFusedBlock];
+  alignas(64) double q[3][kFusedBlock];
+  alignas(64) double length[2][kFusedBlock];
+  alignas(64) double p[3][kFusedBlock];
+};
+
+// Tangents from a general row of T(i)·C(i−1) on the coarse points.
+inline void GeneralTangents(const SynthesisPlan& plan, int row, const double* coarse, double* a,
+                            double* b) {
+  a[0] = a[1] = a[2] = b[0] = b[1] = b[2] = 0.0;
+  const double* w = plan.general_weights.data() + 2 * plan.general_offsets[row];
+  for (int i = plan.general_offsets[row]; i < plan.general_offsets[row + 1]; ++i, w += 2) {
+    const double* x = coarse + 3 * static_cast<Eigen::Index>(plan.general_columns[i]);
+    for (int k = 0; k < 3; ++k) {
+      a[k] += w[0] * x[k];
+      b[k] += w[1] * x[k];
+    }
+  }
+}
+
+// out rows = block.p + F d for the block's vertices, d and out starting at `first`.
+template <typename Block>
+inline void WriteDetailed(const Block& block, int size, const double* __restrict d,
+                          double* __restrict out) {
+  for (int j = 0; j < size; ++j)
+    for (int k = 0; k < 3; ++k)
+      out[3 * j + k] = block.p[k][j] + (d[3 * j] * block.n[k][j] + d[3 * j + 1] * block.r[k][j] +
+                                        d[3 * j + 2] * block.q[k][j]);
 }
 
 }  // namespace
@@ -265,6 +305,146 @@ void AddDetailsInLocalFrames(const LoopHierarchy& hierarchy, int level,
         for (int k = 0; k < 3; ++k)
           ov[3 * j + k] = pv[3 * j + k] + (dv[3 * j] * block.n[k][j] + dv[3 * j + 1] * block.r[k][j] +
                                            dv[3 * j + 2] * block.q[k][j]);
+    }
+  });
+}
+
+void RefineAndAddDetails(const LoopHierarchy& hierarchy, int level, const Positions& coarse,
+                         const Positions& local, Positions* result) {
+  SUBFLOW_CHECK(level >= 1 && level <= hierarchy.finest_level(), "level out of range");
+  SUBFLOW_CHECK(coarse.rows() == hierarchy.VertexCount(level - 1) &&
+                    local.rows() == hierarchy.VertexCount(level),
+                "points or details do not match the levels' vertex counts");
+  SUBFLOW_CHECK(result != &coarse && result != &local, "output aliases input");
+  const SynthesisPlan& plan = hierarchy.SynthesisPlanOf(level);
+  const PointStencil& refinement = hierarchy.RefinementStencil(level - 1);
+  const PointStencil& coarse_tangents = hierarchy.LimitTangentStencil(level - 1);
+  const int regular_offset = coarse_tangents.PatternWeightOffset(6);
+  const int nc = plan.coarse_vertex_count;
+  result->resize(hierarchy.VertexCount(level), 3);
+  // The even predicted points p(v) = (C c)(v), v < #V(level − 1): the odd tangents use them.
+  Positions even(nc, 3);
+  const double* c = coarse.data();
+  const double* d = local.data();
+  double* out = result->data();
+  double* even_points = even.data();
+  const int* offsets = refinement.offsets();
+  const int* columns = refinement.columns();
+  const int* weight_offsets = refinement.weight_offsets();
+  const double* weights = refinement.weights();
+  const double* rotations = plan.rotations.data();
+
+  // Even vertices: p by the refinement row (Apply's sums, in its order), tangents by level
+  // level − 1's stencil at v on the coarse points, rotated.
+  ForEachRowBlock(nc, [&](int begin, int end) {
+    FusedBlock block;
+    for (int first = begin; first < end; first += kFusedBlock) {
+      const int size = std::min(kFusedBlock, end - first);
+      for (int j = 0; j < size; ++j) {
+        const int v = first + j;
+        const double* w = weights + weight_offsets[v];
+        const int* column = columns + offsets[v];
+        const int count = offsets[v + 1] - offsets[v];
+        double s[3] = {0.0, 0.0, 0.0};
+        for (int i = 0; i < count; ++i) {
+          const double* x = c + 3 * static_cast<Eigen::Index>(column[i]);
+          s[0] += w[i] * x[0];
+          s[1] += w[i] * x[1];
+          s[2] += w[i] * x[2];
+        }
+        double t1[3], t2[3];
+        const std::uint8_t rotation = plan.even_rotation[v];
+        if (rotation == SynthesisPlan::kGeneral) {
+          GeneralTangents(plan, plan.even_general_row[v], c, t1, t2);
+        } else {
+          double a[3], b[3];
+          if (count == 7) {  // interior, valence 6: the ring is the row's columns 1..6
+            const double* p0 = c + 3 * static_cast<Eigen::Index>(column[1]);
+            const double* p1 = c + 3 * static_cast<Eigen::Index>(column[2]);
+            const double* p2 = c + 3 * static_cast<Eigen::Index>(column[3]);
+            const double* p3 = c + 3 * static_cast<Eigen::Index>(column[4]);
+            const double* p4 = c + 3 * static_cast<Eigen::Index>(column[5]);
+            const double* p5 = c + 3 * static_cast<Eigen::Index>(column[6]);
+            const double h = 0.8660254037844386;  // √3/2
+            for (int k = 0; k < 3; ++k) {
+              a[k] = (p0[k] - p3[k]) + 0.5 * ((p1[k] + p5[k]) - (p2[k] + p4[k]));
+              b[k] = h * ((p1[k] + p2[k]) - (p4[k] + p5[k]));
+            }
+          } else {
+            TangentsAt(coarse_tangents, regular_offset, c, v, a, b);
+          }
+          const double cs = rotations[2 * rotation], sn = rotations[2 * rotation + 1];
+          for (int k = 0; k < 3; ++k) {
+            t1[k] = cs * a[k] - sn * b[k];
+            t2[k] = cs * b[k] + sn * a[k];
+          }
+        }
+        for (int k = 0; k < 3; ++k) {
+          even_points[3 * static_cast<Eigen::Index>(v) + k] = s[k];
+          block.p[k][j] = s[k];
+          block.a[k][j] = t1[k];
+          block.b[k][j] = t2[k];
+        }
+      }
+      FramesOfBlock(size, &block);
+      WriteDetailed(block, size, d + 3 * static_cast<Eigen::Index>(first),
+                    out + 3 * static_cast<Eigen::Index>(first));
+    }
+  });
+
+  // Odd vertices: p = 3/8 (a + b) + 1/8 (P + Q) (Apply's order), tangents by the closed
+  // form of synthesis_plan.h on the coarse and even predicted points.
+  ForEachRowBlock(plan.odd_vertex_count, [&](int begin, int end) {
+    FusedBlock block;
+    for (int first = begin; first < end; first += kFusedBlock) {
+      const int size = std::min(kFusedBlock, end - first);
+      for (int j = 0; j < size; ++j) {
+        const int e = first + j;
+        const int m = nc + e;
+        const int* col = plan.odd_columns.data() + 8 * static_cast<Eigen::Index>(e);
+        const std::uint8_t rotation = plan.odd_rotation[e];
+        double t1[3], t2[3];
+        if (rotation == SynthesisPlan::kGeneral) {
+          const double* w = weights + weight_offsets[m];
+          double s[3] = {0.0, 0.0, 0.0};
+          for (int i = offsets[m]; i < offsets[m + 1]; ++i, ++w) {
+            const double* x = c + 3 * static_cast<Eigen::Index>(columns[i]);
+            s[0] += *w * x[0];
+            s[1] += *w * x[1];
+            s[2] += *w * x[2];
+          }
+          GeneralTangents(plan, col[0], c, t1, t2);
+          for (int k = 0; k < 3; ++k) block.p[k][j] = s[k];
+        } else {
+          const double* pa = c + 3 * static_cast<Eigen::Index>(col[0]);
+          const double* pb = c + 3 * static_cast<Eigen::Index>(col[1]);
+          const double* pp = c + 3 * static_cast<Eigen::Index>(col[2]);
+          const double* pq = c + 3 * static_cast<Eigen::Index>(col[3]);
+          const double* x1 = c + 3 * static_cast<Eigen::Index>(col[4]);
+          const double* x2 = c + 3 * static_cast<Eigen::Index>(col[5]);
+          const double* x3 = c + 3 * static_cast<Eigen::Index>(col[6]);
+          const double* x4 = c + 3 * static_cast<Eigen::Index>(col[7]);
+          const double* ea = even_points + 3 * static_cast<Eigen::Index>(col[0]);
+          const double* eb = even_points + 3 * static_cast<Eigen::Index>(col[1]);
+          const double cs = rotations[2 * rotation], sn = rotations[2 * rotation + 1];
+          const double h = 0.8660254037844386;  // √3/2
+          for (int k = 0; k < 3; ++k) {
+            block.p[k][j] = ((0.375 * pa[k] + 0.375 * pb[k]) + 0.125 * pp[k]) + 0.125 * pq[k];
+            const double a0 = (ea[k] - eb[k]) + 0.25 * (pa[k] - pb[k]) +
+                              0.0625 * ((x1[k] + x4[k]) - (x2[k] + x3[k]));
+            const double b0 = h * (0.75 * (pq[k] - pp[k]) + 0.125 * ((x1[k] + x2[k]) - (x3[k] + x4[k])));
+            t1[k] = cs * a0 - sn * b0;
+            t2[k] = cs * b0 + sn * a0;
+          }
+        }
+        for (int k = 0; k < 3; ++k) {
+          block.a[k][j] = t1[k];
+          block.b[k][j] = t2[k];
+        }
+      }
+      FramesOfBlock(size, &block);
+      WriteDetailed(block, size, d + 3 * static_cast<Eigen::Index>(nc + first),
+                    out + 3 * static_cast<Eigen::Index>(nc + first));
     }
   });
 }

@@ -56,6 +56,15 @@ void AddDetailsInLocalFrames(const LoopHierarchy& hierarchy, int level,
                              const Positions& predicted, const Positions& local,
                              Positions* result);
 
+// The whole synthesis step into `level` ≥ 1 in two passes (even, then odd vertices):
+//   result = p + F d,  p = C(level − 1) coarse,  F the frames of p at `level`,
+// d = `local`. Equal to RefinementStencil(level − 1).Apply then AddDetailsInLocalFrames up
+// to rounding (p itself is computed with Apply's sums): the tangents of p come from the
+// coarse points through the tables of hierarchy.SynthesisPlanOf(level), so the odd rows of
+// p are never stored or gathered. `result` must not alias the inputs.
+void RefineAndAddDetails(const LoopHierarchy& hierarchy, int level, const Positions& coarse,
+                         const Positions& local, Positions* result);
+
 // Limit normals only (#V×3 unit rows), same convention as LocalFrames::normal.
 Positions LimitNormals(const LoopHierarchy& hierarchy, int level,
                        const Positions& control_points);

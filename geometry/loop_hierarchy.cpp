@@ -73,6 +73,10 @@ LoopHierarchy::LoopHierarchy(const Faces& base_faces, int vertex_count, int leve
       coarsening_.push_back(std::move(coarsening));
     }
   }
+  for (int level = 1; level <= levels; ++level)
+    synthesis_plans_.push_back(BuildSynthesisPlan(topology_[level - 1], topology_[level],
+                                                  refinement_stencils_[level - 1],
+                                                  tangent_stencils_[level]));
 }
 
 bool LoopHierarchy::IsOddVertex(int level, int vertex) const {

@@ -30,6 +30,7 @@
 #include "geometry/loop_operators.h"
 #include "geometry/mesh_topology.h"
 #include "geometry/point_stencil.h"
+#include "geometry/synthesis_plan.h"
 #include "geometry/triangle_mesh.h"
 
 namespace subflow::geometry {
@@ -85,6 +86,8 @@ class LoopHierarchy {
   // Hot-path forms (point_stencil.h): C(i) for 0 ≤ level < n, and [T1, T2] (two channels).
   const PointStencil& RefinementStencil(int level) const { return refinement_stencils_.at(level); }
   const PointStencil& LimitTangentStencil(int level) const { return tangent_stencils_.at(level); }
+  // The tables of the fused synthesis step into `level` (1 ≤ level ≤ n, synthesis_plan.h).
+  const SynthesisPlan& SynthesisPlanOf(int level) const { return synthesis_plans_.at(level - 1); }
 
   // Control points of `to_level` from control points of `from_level` by repeated
   // refinement (no details): c(to) = C(to−1) ⋯ C(from) c(from), with the stencils.
@@ -100,6 +103,7 @@ class LoopHierarchy {
   std::vector<std::array<SparseMatrix, 2>> limit_tangents_;
   std::vector<PointStencil> refinement_stencils_;  // levels 0..n−1
   std::vector<PointStencil> tangent_stencils_;     // levels 0..n
+  std::vector<SynthesisPlan> synthesis_plans_;     // levels 1..n, stored at [level − 1]
 };
 
 // The faces of the next level (the 1-to-4 split documented above) from level i's faces and

@@ -75,17 +75,18 @@ Positions MultiresShape::Synthesize(const LoopHierarchy& hierarchy, int level,
     frames->clear();
     frames->resize(level);
   }
-  Positions c = base_, predicted;
+  Positions c = base_, next;
   for (int i = 1; i <= level; ++i) {
-    hierarchy.RefinementStencil(i - 1).Apply(c, &predicted);
     if (i > detail_levels()) {
-      c.swap(predicted);
+      hierarchy.RefinementStencil(i - 1).Apply(c, &next);
     } else if (frames) {
-      (*frames)[i - 1] = ComputeLocalFrames(hierarchy, i, predicted);
-      c = predicted + (*frames)[i - 1].ToWorld(Detail(i));
+      hierarchy.RefinementStencil(i - 1).Apply(c, &next);
+      (*frames)[i - 1] = ComputeLocalFrames(hierarchy, i, next);
+      next += (*frames)[i - 1].ToWorld(Detail(i));
     } else {
-      AddDetailsInLocalFrames(hierarchy, i, predicted, Detail(i), &c);
+      RefineAndAddDetails(hierarchy, i, c, Detail(i), &next);
     }
+    c.swap(next);
   }
   return c;
 }

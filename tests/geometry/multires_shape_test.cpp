@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -195,6 +196,30 @@ TEST(MultiresShape, RejectsControlPointsOfTheWrongSize) {
   shape.Detail(2) = Positions::Zero(5, 3);
   EXPECT_NE(message([&] { shape.Synthesize(bumpy.hierarchy, 3); })
                 .find("detail level 2: has 5 rows, expected 162"), std::string::npos);
+}
+
+// The hot path (RefineAndAddDetails: tangents of the predicted points from the coarse
+// points, synthesis_plan.h) agrees with refining, then framing the predicted points, on a
+// closed mesh with valence-5 vertices and on an open one (general rows at the boundary).
+TEST(MultiresShape, FusedSynthesisMatchesRefineThenFrame) {
+  const Bumpy bumpy;
+  const TriangleMesh patch = GridPatch(4, 3);
+  const LoopHierarchy open(patch.F, patch.vertex_count(), 3);
+  const Positions open_finest = AddNoise(open.Refine(AddNoise(patch.V, 0.2, 3), 0, 3), 0.05, 4);
+  for (const auto& [hierarchy, finest] :
+       {std::pair<const LoopHierarchy*, const Positions*>{&bumpy.hierarchy, &bumpy.finest},
+        std::pair<const LoopHierarchy*, const Positions*>{&open, &open_finest}}) {
+    const MultiresShape shape = MultiresShape::Analyze(*hierarchy, *finest);
+    Positions c = shape.base();
+    for (int level = 1; level <= 3; ++level) {
+      Positions predicted, expected, fused;
+      hierarchy->RefinementStencil(level - 1).Apply(c, &predicted);
+      AddDetailsInLocalFrames(*hierarchy, level, predicted, shape.Detail(level), &expected);
+      RefineAndAddDetails(*hierarchy, level, c, shape.Detail(level), &fused);
+      EXPECT_LT((fused - expected).cwiseAbs().maxCoeff(), 1e-13) << "level " << level;
+      c = expected;
+    }
+  }
 }
 
 }  // namespace
