@@ -13,6 +13,10 @@ namespace subflow::cli {
 nlohmann::json VersionsJson();
 // {"directory", "cameras", "frames", "bounds", "has_masks", ...}.
 nlohmann::json DatasetJson(const vision::Dataset& dataset);
+// Every field of the silhouette and voxel-carving options (what report.json records of
+// them; automatic values are recorded as given, e.g. −1, with the values used per frame).
+nlohmann::json SilhouetteOptionsJson(const vision::SilhouetteOptions& options);
+nlohmann::json VoxelCarvingOptionsJson(const vision::VoxelCarvingOptions& options);
 // The options of shape initialization, field by field.
 nlohmann::json ShapeInitOptionsJson(const solver::ShapeInitOptions& options);
 // Options, base mesh, hierarchy and per-frame figures of shape initialization.

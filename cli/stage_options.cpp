@@ -23,7 +23,7 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
   sub->add_option("--motion-threshold", o->silhouettes.motion_threshold,
                   "Threshold of the motion evidence (< 0 = automatic, Otsu)")->capture_default_str();
   sub->add_option("--background-threshold", o->silhouettes.background_threshold,
-                  "Threshold of the background difference (< 0 = automatic, Otsu)")->capture_default_str();
+                  "Threshold of the background difference (< 0 = automatic, triangle)")->capture_default_str();
 }
 
 void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o) {

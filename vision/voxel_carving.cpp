@@ -213,6 +213,7 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
     report.name = camera.name();
     report.source = silhouette.source;
     report.object_pixels = silhouette.object_pixels;
+    report.threshold = silhouette.threshold;
     if (silhouette.evidence.type() != CV_32FC1 || silhouette.evidence.cols != camera.width() ||
         silhouette.evidence.rows != camera.height())
       ThrowError(where, "camera \"" + camera.name() + "\": silhouette",

@@ -111,6 +111,9 @@ struct CameraCarvingReport {
   bool used = false;       // took part in the carving
   std::string excluded;    // why not, "" when used
   int object_pixels = 0;   // pixels of the silhouette
+  // The threshold that made the silhouette from its measure (Silhouette::threshold): 0.5
+  // for masks, else the automatic (Otsu / triangle) or given value, in the measure's units.
+  double threshold = 0.5;
   // |P ∩ S| / |P ∪ S| over the image, P = the projection of the occupied voxels' cubes
   // (ProjectOccupancy), S = this camera's silhouette; NaN for unused cameras or when not
   // computed. The cubes' staircase reaches a little beyond the iso-surface at ½, and the

@@ -1,10 +1,12 @@
-// `subflow hull`: on a tiny synthetic sphere dataset its progress prints each stage's
-// final line once.
+// `subflow hull`: on a tiny synthetic sphere dataset it writes the OUTPUT.md layout and a
+// report.json that records every silhouette and carving option it ran with (and the
+// values chosen automatically), and its progress prints each stage's final line once.
 #include <filesystem>
 #include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
 #include "vision/synthetic_render.h"
@@ -49,6 +51,56 @@ int CountLines(const std::string& text, const std::string& a, const std::string&
   for (std::string line; std::getline(lines, line);)
     count += line.find(a) != std::string::npos && line.find(b) != std::string::npos;
   return count;
+}
+
+TEST(HullCommand, ReportRecordsEverySilhouetteAndCarvingOptionAndTheValuesUsed) {
+  const fs::path out = Scratch().FreshPath("report");
+  const test::CommandResult run = test::RunSubflow(HullArguments(out), Scratch().path());
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  ASSERT_TRUE(fs::exists(out / "meshes" / "000002.ply"));
+  const nlohmann::json report = nlohmann::json::parse(test::ReadTextFile(out / "report.json"));
+  const nlohmann::json& options = report.at("options").at("shape_init");
+
+  // Every field of SilhouetteOptions and VoxelCarvingOptions (vision/silhouettes.h,
+  // vision/voxel_carving.h), with the values given on the command line.
+  const nlohmann::json& silhouettes = options.at("silhouettes");
+  for (const char* field :
+       {"source", "background_blur_sigma", "background_threshold", "background_method",
+        "background_open_radius", "background_min_threshold", "motion_sigma", "motion_lambda",
+        "motion_window", "motion_threshold", "motion_method", "motion_min_threshold",
+        "close_radius", "fill_holes", "min_region_pixels", "min_object_pixels"})
+    EXPECT_TRUE(silhouettes.contains(field)) << "silhouettes." << field;
+  EXPECT_EQ(silhouettes.size(), 16u) << silhouettes.dump();
+  EXPECT_EQ(silhouettes.at("background_threshold").get<double>(), 0.07);
+  EXPECT_EQ(silhouettes.at("background_method").get<std::string>(), "triangle");
+  EXPECT_EQ(silhouettes.at("motion_method").get<std::string>(), "otsu");
+  const nlohmann::json& carving = options.at("carving");
+  for (const char* field :
+       {"resolution", "pixels_per_voxel", "max_auto_resolution", "min_cameras", "max_misses",
+        "evidence_threshold", "footprint_margin", "closing_radius", "opening_radius",
+        "connectivity", "min_component_fraction", "fill_cavities", "compute_silhouette_iou",
+        "threads"})
+    EXPECT_TRUE(carving.contains(field)) << "carving." << field;
+  EXPECT_EQ(carving.size(), 14u) << carving.dump();
+  EXPECT_EQ(carving.at("min_cameras").get<int>(), 3);
+  EXPECT_EQ(carving.at("max_misses").get<int>(), -1);  // automatic, as given
+  EXPECT_EQ(carving.at("footprint_margin").get<double>(), 0.5);
+
+  // Per frame, the values the automatic options took: masks everywhere → max_misses 0,
+  // threshold 0.5 per camera.
+  const nlohmann::json& frames = report.at("shape_init").at("frames");
+  ASSERT_EQ(frames.size(), 3u);
+  for (const nlohmann::json& frame : frames) {
+    EXPECT_EQ(frame.at("max_misses").get<int>(), 0);
+    EXPECT_GT(frame.at("voxel_resolution").get<int>(), 8);
+    EXPECT_GE(frame.at("carved_voxels").get<long>(), frame.at("occupied_voxels").get<long>() / 2);
+    EXPECT_EQ(frame.at("border_voxels").size(), 6u);
+    ASSERT_EQ(frame.at("cameras").size(), 5u);
+    for (const nlohmann::json& camera : frame.at("cameras")) {
+      EXPECT_EQ(camera.at("source").get<std::string>(), "mask");
+      EXPECT_EQ(camera.at("threshold").get<double>(), 0.5);
+    }
+  }
 }
 
 TEST(HullCommand, ProgressPrintsEachStagesFinalLineOnce) {
