@@ -55,12 +55,13 @@ namespace subflow::solver {
 struct StereoRefinementOptions {
   int coarsest_level = 0;
   // −1: automatic, the finest level whose patches still cover min_patch_area pixels² (median
-  // over the faces some camera faces, at the middle frame): a correlation window needs
-  // texture. On the blob (320×240) that is level 1 of 3 (~12 px² per patch); refining
-  // level 2 as well (~3 px²) took twice as long for the same accuracy (0.50 against
-  // 0.46 mm P90 on frames 10–12) and end-point error.
+  // over the base faces of their largest projected area, divided by 4 per level, at the
+  // middle frame): a correlation window of about 4.5 × 4.5 px needs that much texture. On
+  // the blob (320×240) that is level 1 of 3; refining level 2 as well (~12 px² per patch)
+  // took twice as long for the same accuracy (0.50 against 0.46 mm P90 on frames 10–12)
+  // and end-point error.
   int finest_level = -1;
-  double min_patch_area = 8.0;
+  double min_patch_area = 20.0;
   // Levels ≥ this refine the normal detail only (dof 1). Tangential increments are nearly
   // unconstrained by stereo (the correlation does not change when the surface slides along
   // itself), so by default every level keeps the tangential motion of motion
