@@ -1,7 +1,11 @@
 // The Ceres linear solver of the stereo refinement, chosen by measurement on our real
 // problem: the blob dataset (10 cameras, 320×240), frames 10–12 refined jointly (one
-// window), levels 0–2 (normal-only increments, 400 → 6,400 patches), one round per level,
-// starting from the pipeline's own shape and motion initialization (computed once).
+// window) with the default options (normal-only increments; levels 0–1, 400 and 1,600
+// patches, by the automatic finest level), starting from the pipeline's own shape and
+// motion initialization (computed once).
+// Measured 2026-11-26, quiet machine, one run each: sparse_normal_cholesky 9.70 s,
+// sparse_schur 10.9 s, cgnr 11.2 s, iterative_schur 11.9 s (same iterations, mean distance
+// to the truth 0.19–0.20 mm): the default is sparse_normal_cholesky.
 //
 // Per solver: wall time of RefineStereo, time inside ceres::Solve, Ceres iterations,
 // mean NCC after refinement and the mean distance of the output surface (limit positions
