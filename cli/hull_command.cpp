@@ -77,10 +77,7 @@ Command AddHullCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "hull", "Shape initialization (method §4.1): visual hull per frame, base mesh, and a "
               "subdivision surface fitted to every frame on one connectivity");
-  sub->add_option("DATASET", arguments->dataset, "Dataset directory (../shared/DATASET.md)")
-      ->required()->check(CLI::ExistingDirectory);
-  sub->add_option("--out", arguments->out, "Output directory (must be new or empty)")->required();
-  sub->add_flag("--overwrite", arguments->overwrite, "Write into a non-empty output directory");
+  AddDatasetAndOutput(sub, &arguments->dataset, &arguments->out, &arguments->overwrite);
   AddShapeInitOptions(sub, &arguments->options, &arguments->evidence);
   return {sub, [arguments] { RunHull(*arguments); }};
 }

@@ -118,10 +118,7 @@ Command AddReconstructCommand(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "reconstruct", "Multi-view video → time-varying Loop subdivision surface with scene flow "
                      "(shape init, motion init, spatio-temporal stereo, rigid/non-rigid split)");
-  sub->add_option("DATASET", arguments->dataset, "Dataset directory (../shared/DATASET.md)")
-      ->required()->check(CLI::ExistingDirectory);
-  sub->add_option("--out", arguments->out, "Output directory (must be new or empty)")->required();
-  sub->add_flag("--overwrite", arguments->overwrite, "Write into a non-empty output directory");
+  AddDatasetAndOutput(sub, &arguments->dataset, &arguments->out, &arguments->overwrite);
   sub->add_flag("--no-refine", arguments->no_refine,
                 "Stop after motion initialization (no spatio-temporal stereo refinement)");
   sub->add_flag("!--no-retrack", arguments->options.retrack,

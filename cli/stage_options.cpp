@@ -2,6 +2,13 @@
 
 namespace subflow::cli {
 
+void AddDatasetAndOutput(CLI::App* sub, std::string* dataset, std::string* out, bool* overwrite) {
+  sub->add_option("DATASET", *dataset, "Dataset directory (../shared/DATASET.md)")
+      ->required()->check(CLI::ExistingDirectory);
+  sub->add_option("--out", *out, "Output directory (must be new or empty)")->required();
+  sub->add_flag("--overwrite", *overwrite, "Write into a non-empty output directory");
+}
+
 void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string* evidence) {
   sub->add_option("--evidence", *evidence,
                   "Object evidence: auto (masks, else background, else motion), mask, background, motion")

@@ -11,6 +11,10 @@
 
 namespace subflow::cli {
 
+// DATASET (an existing directory), --out (required) and --overwrite: the arguments of every
+// subcommand that reads a dataset and writes a result directory.
+void AddDatasetAndOutput(CLI::App* app, std::string* dataset, std::string* out, bool* overwrite);
+
 // --evidence, --levels, --base-faces, --reference-frame, --first-frame, --frames,
 // --resolution, --min-cameras, --lambda, --motion-threshold, --background-threshold.
 void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::string* evidence);

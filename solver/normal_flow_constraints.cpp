@@ -69,6 +69,22 @@ void CheckCommon(const std::vector<vision::Camera>& cameras, std::size_t images,
       ThrowError("normal flow constraints", "visibility", "sample count differs");
 }
 
+// The checks shared by the step form and its photometric differences; returns whether a
+// displacement guess is given.
+bool CheckStepInputs(const std::vector<vision::Camera>& cameras, const std::vector<SmoothedImage>& before,
+                     const std::vector<SmoothedImage>& after, const geometry::Positions& sample_positions,
+                     const geometry::Positions& sample_displacement, const SampleVisibility& visibility) {
+  CheckCommon(cameras, before.size(), sample_positions, visibility);
+  if (after.size() != before.size())
+    ThrowError("normal flow constraints", "images", "before and after differ in camera count");
+  const bool has_guess = sample_displacement.rows() > 0;
+  if (has_guess && sample_displacement.rows() != sample_positions.rows())
+    ThrowError("normal flow constraints", "sample displacement",
+               std::to_string(sample_displacement.rows()) + " rows for " +
+                   std::to_string(sample_positions.rows()) + " samples");
+  return has_guess;
+}
+
 }  // namespace
 
 Eigen::VectorXd NormalFlowConstraints::Residuals(const geometry::Positions& sample_motion) const {
@@ -96,14 +112,8 @@ NormalFlowConstraints BuildStepConstraints(const std::vector<vision::Camera>& ca
                                            const geometry::Positions& sample_positions,
                                            const geometry::Positions& sample_displacement,
                                            const SampleVisibility& visibility) {
-  CheckCommon(cameras, before.size(), sample_positions, visibility);
-  if (after.size() != before.size())
-    ThrowError("normal flow constraints", "images", "before and after differ in camera count");
-  const bool has_guess = sample_displacement.rows() > 0;
-  if (has_guess && sample_displacement.rows() != sample_positions.rows())
-    ThrowError("normal flow constraints", "sample displacement",
-               std::to_string(sample_displacement.rows()) + " rows for " +
-                   std::to_string(sample_positions.rows()) + " samples");
+  const bool has_guess =
+      CheckStepInputs(cameras, before, after, sample_positions, sample_displacement, visibility);
   return CollectRows(static_cast<int>(sample_positions.rows()), visibility,
                      [&](int s, int k, Row* row) {
     const vision::Camera& camera = cameras[k];
@@ -132,14 +142,8 @@ Eigen::VectorXd StepPhotometricDifferences(const std::vector<vision::Camera>& ca
                                            const geometry::Positions& sample_positions,
                                            const geometry::Positions& sample_displacement,
                                            const SampleVisibility& visibility) {
-  CheckCommon(cameras, before.size(), sample_positions, visibility);
-  if (after.size() != before.size())
-    ThrowError("normal flow constraints", "images", "before and after differ in camera count");
-  const bool has_guess = sample_displacement.rows() > 0;
-  if (has_guess && sample_displacement.rows() != sample_positions.rows())
-    ThrowError("normal flow constraints", "sample displacement",
-               std::to_string(sample_displacement.rows()) + " rows for " +
-                   std::to_string(sample_positions.rows()) + " samples");
+  const bool has_guess =
+      CheckStepInputs(cameras, before, after, sample_positions, sample_displacement, visibility);
   constexpr int kChunk = 1024;
   const int sample_count = static_cast<int>(sample_positions.rows());
   const int chunk_count = (sample_count + kChunk - 1) / kChunk;
