@@ -167,20 +167,6 @@ inline void FramesOfBlock(int count, Block* block) {
   }
 }
 
-// The fused step's block: FrameBlock's arrays plus the predicted points, half as long so
-// that it stays within L1 as well.
-constexpr int kFusedBlock = 128;
-
-struct FusedBlock {
-  alignas(64) double a[3][kFusedBlock];
-  alignas(64) double b[3][kFusedBlock];
-  alignas(64) double n[3][kFusedBlock];
-  alignas(64) double r[3][kFusedBlock];
-  alignas(64) double q[3][kFusedBlock];
-  alignas(64) double length[2][kFusedBlock];
-  alignas(64) double p[3][kFusedBlock];
-};
-
 // Tangents from a general row of T(i)·C(i−1) on the coarse points.
 inline void GeneralTangents(const SynthesisPlan& plan, int row, const double* coarse, double* a,
                             double* b) {
@@ -195,14 +181,267 @@ inline void GeneralTangents(const SynthesisPlan& plan, int row, const double* co
   }
 }
 
-// out rows = block.p + F d for the block's vertices, d and out starting at `first`.
-template <typename Block>
-inline void WriteDetailed(const Block& block, int size, const double* __restrict d,
-                          double* __restrict out) {
-  for (int j = 0; j < size; ++j)
+// ---- The fused synthesis step (RefineAndAddDetails) ----
+//
+// Per block of vertices, two phases:
+//  1. per vertex, gather its few source points and form the predicted point p and the
+//     unrotated tangents (a, b) of synthesis_plan.h, with the three coordinates of a point
+//     in one vector value (x, y, z, 0) — one AVX register, or two SSE2 ones — stored
+//     structure-of-arrays with the vertex's rotation (cos φ, sin φ);
+//  2. element-wise over the block: rotate the tangents, compute the frame (as FramesOfBlock:
+//     degenerate lanes selected, not branched to) and write p + d_n n + d_r r + d_q q; the
+//     compiler vectorizes this loop across vertices.
+// Both phases exist twice: for the x86-64 baseline (SSE2) and, chosen at run time when the
+// CPU has them, for AVX2 with FMA (fused multiply-adds in phase 2 only, so p, and hence
+// synthesis with zero details, is rounded exactly as PointStencil::Apply rounds it).
+constexpr int kSynthesisBlock = 128;  // 11 doubles × 128 = 11 KiB, within L1
+
+struct SynthesisBlock {
+  alignas(64) double p[3][kSynthesisBlock];  // predicted points
+  alignas(64) double a[3][kSynthesisBlock];  // tangents before the rotation
+  alignas(64) double b[3][kSynthesisBlock];
+  alignas(64) double cos[kSynthesisBlock];  // rotation (cos φ, sin φ)
+  alignas(64) double sin[kSynthesisBlock];
+  alignas(64) double n[3][kSynthesisBlock];       // scratch of phase 2: the normal
+  alignas(64) double length[2][kSynthesisBlock];  // and 1/|t1 × t2|, 1/|t1| (squared first)
+};
+
+// The inputs and outputs of one step, shared by the block kernels.
+struct SynthesisStep {
+  const SynthesisPlan* plan;
+  const PointStencil* refinement;       // C(level − 1)
+  const PointStencil* coarse_tangents;  // tangents of level − 1
+  int regular_offset;                   // coarse_tangents' weights of valence-6 vertices
+  const double* coarse;                 // c, #V(level − 1)×3
+  const double* details;                // d, #V(level)×3
+  double* even_points;                  // p of the even vertices (written by the even pass)
+  double* out;                          // result, #V(level)×3
+};
+
+// A point as one vector value (x, y, z, 0) (GCC/Clang vector extension).
+typedef double Point4 __attribute__((vector_size(32)));
+
+#define SUBFLOW_KERNEL inline __attribute__((always_inline))
+
+SUBFLOW_KERNEL Point4 LoadPoint(const double* points, int index) {
+  const double* x = points + 3 * static_cast<Eigen::Index>(index);
+  return Point4{x[0], x[1], x[2], 0.0};
+}
+
+SUBFLOW_KERNEL void StoreColumn(double (*soa)[kSynthesisBlock], int j, Point4 value) {
+  soa[0][j] = value[0];
+  soa[1][j] = value[1];
+  soa[2][j] = value[2];
+}
+
+// a · b + c, fused (one rounding) in the FMA kernels.
+template <bool kFma>
+SUBFLOW_KERNEL double MulAdd(double a, double b, double c) {
+  if constexpr (kFma) return __builtin_fma(a, b, c);
+  return a * b + c;
+}
+
+// Phase 2 over the first `size` vertices of the block; d and out start at its first vertex.
+// Three element-wise loops (as FramesOfBlock): the rotated tangents' cross product and
+// squared lengths with the degenerate lanes selected; the reciprocal lengths; the frame
+// and the output row.
+template <bool kFma>
+SUBFLOW_KERNEL void FinishBlock(SynthesisBlock* block, int size, const double* __restrict d,
+                                double* __restrict out) {
+  for (int j = 0; j < size; ++j) {
+    const double cs = block->cos[j], sn = block->sin[j];
+    double t1[3], t2[3];
+    for (int k = 0; k < 3; ++k) {
+      t1[k] = MulAdd<kFma>(cs, block->a[k][j], -(sn * block->b[k][j]));
+      t2[k] = MulAdd<kFma>(cs, block->b[k][j], sn * block->a[k][j]);
+    }
+    const double x = MulAdd<kFma>(t1[1], t2[2], -(t1[2] * t2[1]));
+    const double y = MulAdd<kFma>(t1[2], t2[0], -(t1[0] * t2[2]));
+    const double z = MulAdd<kFma>(t1[0], t2[1], -(t1[1] * t2[0]));
+    const double cross2 = MulAdd<kFma>(x, x, MulAdd<kFma>(y, y, z * z));
+    const double a_2 = MulAdd<kFma>(t1[0], t1[0], MulAdd<kFma>(t1[1], t1[1], t1[2] * t1[2]));
+    const double b_2 = MulAdd<kFma>(t2[0], t2[0], MulAdd<kFma>(t2[1], t2[1], t2[2] * t2[2]));
+    const bool regular = cross2 > kDegenerateSine * kDegenerateSine * a_2 * b_2;  // false on NaN
+    block->n[0][j] = regular ? x : 0.0;
+    block->n[1][j] = regular ? y : 0.0;
+    block->n[2][j] = regular ? z : 1.0;
+    block->a[0][j] = regular ? t1[0] : 1.0;  // a becomes r
+    block->a[1][j] = regular ? t1[1] : 0.0;
+    block->a[2][j] = regular ? t1[2] : 0.0;
+    block->length[0][j] = regular ? cross2 : 1.0;
+    block->length[1][j] = regular ? a_2 : 1.0;
+  }
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < size; ++j) block->length[i][j] = 1.0 / std::sqrt(block->length[i][j]);
+  for (int j = 0; j < size; ++j) {
+    const double n[3] = {block->n[0][j] * block->length[0][j],
+                         block->n[1][j] * block->length[0][j],
+                         block->n[2][j] * block->length[0][j]};
+    const double r[3] = {block->a[0][j] * block->length[1][j],
+                         block->a[1][j] * block->length[1][j],
+                         block->a[2][j] * block->length[1][j]};
+    const double q[3] = {MulAdd<kFma>(n[1], r[2], -(n[2] * r[1])),
+                         MulAdd<kFma>(n[2], r[0], -(n[0] * r[2])),
+                         MulAdd<kFma>(n[0], r[1], -(n[1] * r[0]))};
+    const double dn = d[3 * j], dr = d[3 * j + 1], dq = d[3 * j + 2];
     for (int k = 0; k < 3; ++k)
-      out[3 * j + k] = block.p[k][j] + (d[3 * j] * block.n[k][j] + d[3 * j + 1] * block.r[k][j] +
-                                        d[3 * j + 2] * block.q[k][j]);
+      out[3 * j + k] =
+          block->p[k][j] + MulAdd<kFma>(dn, n[k], MulAdd<kFma>(dr, r[k], dq * q[k]));
+  }
+}
+
+// Phase 1 of the even vertices v ∈ [first, first + size): p by the refinement row (Apply's
+// sums, in its order; also stored to even_points for the odd pass), tangents by level
+// level − 1's stencil at v on the coarse points.
+SUBFLOW_KERNEL void GatherEvenBlock(const SynthesisStep& step, int first, int size,
+                                    SynthesisBlock* block) {
+  const PointStencil& refinement = *step.refinement;
+  const int* offsets = refinement.offsets();
+  const int* columns = refinement.columns();
+  const int* weight_offsets = refinement.weight_offsets();
+  const double* weights = refinement.weights();
+  const SynthesisPlan& plan = *step.plan;
+  const double* c = step.coarse;
+  for (int j = 0; j < size; ++j) {
+    const int v = first + j;
+    const double* w = weights + weight_offsets[v];
+    const int* column = columns + offsets[v];
+    const int count = offsets[v + 1] - offsets[v];
+    const std::uint8_t rotation = plan.even_rotation[v];
+    Point4 s, a, b;
+    if (count == 7 && rotation != SynthesisPlan::kGeneral) {
+      // Interior, valence 6: the ring is the row's columns 1..6.
+      const Point4 x0 = LoadPoint(c, column[0]), x1 = LoadPoint(c, column[1]),
+                   x2 = LoadPoint(c, column[2]), x3 = LoadPoint(c, column[3]),
+                   x4 = LoadPoint(c, column[4]), x5 = LoadPoint(c, column[5]),
+                   x6 = LoadPoint(c, column[6]);
+      s = w[0] * x0;
+      s += w[1] * x1;
+      s += w[2] * x2;
+      s += w[3] * x3;
+      s += w[4] * x4;
+      s += w[5] * x5;
+      s += w[6] * x6;
+      const double h = 0.8660254037844386;  // √3/2
+      a = (x1 - x4) + 0.5 * ((x2 + x6) - (x3 + x5));
+      b = h * ((x2 + x3) - (x5 + x6));
+    } else {
+      s = Point4{0.0, 0.0, 0.0, 0.0};
+      for (int i = 0; i < count; ++i) s += w[i] * LoadPoint(c, column[i]);
+      double t1[3], t2[3];
+      if (rotation == SynthesisPlan::kGeneral)
+        GeneralTangents(plan, plan.even_general_row[v], c, t1, t2);
+      else
+        TangentsAt(*step.coarse_tangents, step.regular_offset, c, v, t1, t2);
+      a = Point4{t1[0], t1[1], t1[2], 0.0};
+      b = Point4{t2[0], t2[1], t2[2], 0.0};
+    }
+    double* even = step.even_points + 3 * static_cast<Eigen::Index>(v);
+    even[0] = s[0], even[1] = s[1], even[2] = s[2];
+    StoreColumn(block->p, j, s);
+    StoreColumn(block->a, j, a);
+    StoreColumn(block->b, j, b);
+    const int rotation_index = rotation == SynthesisPlan::kGeneral ? 0 : rotation;
+    block->cos[j] = plan.rotations[2 * rotation_index];
+    block->sin[j] = plan.rotations[2 * rotation_index + 1];
+  }
+}
+
+// Phase 1 of the odd vertices nc + e, e ∈ [first, first + size): p = 3/8 (a + b) +
+// 1/8 (P + Q) (Apply's order), tangents by the closed form of synthesis_plan.h on the
+// coarse and even predicted points; general rows otherwise.
+SUBFLOW_KERNEL void GatherOddBlock(const SynthesisStep& step, int first, int size,
+                                   SynthesisBlock* block) {
+  const SynthesisPlan& plan = *step.plan;
+  const PointStencil& refinement = *step.refinement;
+  const double* c = step.coarse;
+  const double* even = step.even_points;
+  const double* rotations = plan.rotations.data();
+  for (int j = 0; j < size; ++j) {
+    const int e = first + j;
+    const int* col = plan.odd_columns.data() + 8 * static_cast<Eigen::Index>(e);
+    const std::uint8_t rotation = plan.odd_rotation[e];
+    Point4 p, a, b;
+    if (rotation == SynthesisPlan::kGeneral) {
+      const int m = plan.coarse_vertex_count + e;
+      const double* w = refinement.weights() + refinement.weight_offsets()[m];
+      p = Point4{0.0, 0.0, 0.0, 0.0};
+      for (int i = refinement.offsets()[m]; i < refinement.offsets()[m + 1]; ++i, ++w)
+        p += *w * LoadPoint(c, refinement.columns()[i]);
+      double t1[3], t2[3];
+      GeneralTangents(plan, col[0], c, t1, t2);
+      a = Point4{t1[0], t1[1], t1[2], 0.0};
+      b = Point4{t2[0], t2[1], t2[2], 0.0};
+    } else {
+      const Point4 pa = LoadPoint(c, col[0]), pb = LoadPoint(c, col[1]),
+                   pp = LoadPoint(c, col[2]), pq = LoadPoint(c, col[3]),
+                   x1 = LoadPoint(c, col[4]), x2 = LoadPoint(c, col[5]),
+                   x3 = LoadPoint(c, col[6]), x4 = LoadPoint(c, col[7]),
+                   ea = LoadPoint(even, col[0]), eb = LoadPoint(even, col[1]);
+      p = ((0.375 * pa + 0.375 * pb) + 0.125 * pp) + 0.125 * pq;
+      a = (ea - eb) + 0.25 * (pa - pb) + 0.0625 * ((x1 + x4) - (x2 + x3));
+      const double h = 0.8660254037844386;  // √3/2
+      b = h * (0.75 * (pq - pp) + 0.125 * ((x1 + x2) - (x3 + x4)));
+    }
+    StoreColumn(block->p, j, p);
+    StoreColumn(block->a, j, a);
+    StoreColumn(block->b, j, b);
+    const int rotation_index = rotation == SynthesisPlan::kGeneral ? 0 : rotation;
+    block->cos[j] = rotations[2 * rotation_index];
+    block->sin[j] = rotations[2 * rotation_index + 1];
+  }
+}
+
+// Even vertices [begin, end) and odd vertices nc + [begin, end) of a step, block by block.
+template <bool kFma>
+SUBFLOW_KERNEL void EvenVertices(const SynthesisStep& step, int begin, int end) {
+  SynthesisBlock block;
+  for (int first = begin; first < end; first += kSynthesisBlock) {
+    const int size = std::min(kSynthesisBlock, end - first);
+    GatherEvenBlock(step, first, size, &block);
+    FinishBlock<kFma>(&block, size, step.details + 3 * static_cast<Eigen::Index>(first),
+                      step.out + 3 * static_cast<Eigen::Index>(first));
+  }
+}
+
+template <bool kFma>
+SUBFLOW_KERNEL void OddVertices(const SynthesisStep& step, int begin, int end) {
+  SynthesisBlock block;
+  const Eigen::Index nc = step.plan->coarse_vertex_count;
+  for (int first = begin; first < end; first += kSynthesisBlock) {
+    const int size = std::min(kSynthesisBlock, end - first);
+    GatherOddBlock(step, first, size, &block);
+    FinishBlock<kFma>(&block, size, step.details + 3 * (nc + first),
+                      step.out + 3 * (nc + first));
+  }
+}
+
+void EvenVerticesBaseline(const SynthesisStep& step, int begin, int end) {
+  EvenVertices<false>(step, begin, end);
+}
+void OddVerticesBaseline(const SynthesisStep& step, int begin, int end) {
+  OddVertices<false>(step, begin, end);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define SUBFLOW_HAVE_AVX2_KERNELS 1
+__attribute__((target("avx2,fma"))) void EvenVerticesAvx2Fma(const SynthesisStep& step,
+                                                             int begin, int end) {
+  EvenVertices<true>(step, begin, end);
+}
+__attribute__((target("avx2,fma"))) void OddVerticesAvx2Fma(const SynthesisStep& step,
+                                                            int begin, int end) {
+  OddVertices<true>(step, begin, end);
+}
+#endif
+
+bool CpuHasAvx2Fma() {
+#ifdef SUBFLOW_HAVE_AVX2_KERNELS
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+#else
+  return false;
+#endif
 }
 
 }  // namespace
@@ -309,144 +548,43 @@ void AddDetailsInLocalFrames(const LoopHierarchy& hierarchy, int level,
   });
 }
 
+bool SynthesisKernelAvailable(SynthesisKernel kernel) {
+  return kernel != SynthesisKernel::kAvx2Fma || CpuHasAvx2Fma();
+}
+
 void RefineAndAddDetails(const LoopHierarchy& hierarchy, int level, const Positions& coarse,
-                         const Positions& local, Positions* result) {
+                         const Positions& local, Positions* result, SynthesisKernel kernel) {
   SUBFLOW_CHECK(level >= 1 && level <= hierarchy.finest_level(), "level out of range");
   SUBFLOW_CHECK(coarse.rows() == hierarchy.VertexCount(level - 1) &&
                     local.rows() == hierarchy.VertexCount(level),
                 "points or details do not match the levels' vertex counts");
   SUBFLOW_CHECK(result != &coarse && result != &local, "output aliases input");
+  SUBFLOW_CHECK(SynthesisKernelAvailable(kernel), "the CPU lacks AVX2 or FMA");
   const SynthesisPlan& plan = hierarchy.SynthesisPlanOf(level);
-  const PointStencil& refinement = hierarchy.RefinementStencil(level - 1);
   const PointStencil& coarse_tangents = hierarchy.LimitTangentStencil(level - 1);
-  const int regular_offset = coarse_tangents.PatternWeightOffset(6);
-  const int nc = plan.coarse_vertex_count;
   result->resize(hierarchy.VertexCount(level), 3);
   // The even predicted points p(v) = (C c)(v), v < #V(level − 1): the odd tangents use them.
-  Positions even(nc, 3);
-  const double* c = coarse.data();
-  const double* d = local.data();
-  double* out = result->data();
-  double* even_points = even.data();
-  const int* offsets = refinement.offsets();
-  const int* columns = refinement.columns();
-  const int* weight_offsets = refinement.weight_offsets();
-  const double* weights = refinement.weights();
-  const double* rotations = plan.rotations.data();
-
-  // Even vertices: p by the refinement row (Apply's sums, in its order), tangents by level
-  // level − 1's stencil at v on the coarse points, rotated.
-  ForEachRowBlock(nc, [&](int begin, int end) {
-    FusedBlock block;
-    for (int first = begin; first < end; first += kFusedBlock) {
-      const int size = std::min(kFusedBlock, end - first);
-      for (int j = 0; j < size; ++j) {
-        const int v = first + j;
-        const double* w = weights + weight_offsets[v];
-        const int* column = columns + offsets[v];
-        const int count = offsets[v + 1] - offsets[v];
-        double s[3] = {0.0, 0.0, 0.0};
-        for (int i = 0; i < count; ++i) {
-          const double* x = c + 3 * static_cast<Eigen::Index>(column[i]);
-          s[0] += w[i] * x[0];
-          s[1] += w[i] * x[1];
-          s[2] += w[i] * x[2];
-        }
-        double t1[3], t2[3];
-        const std::uint8_t rotation = plan.even_rotation[v];
-        if (rotation == SynthesisPlan::kGeneral) {
-          GeneralTangents(plan, plan.even_general_row[v], c, t1, t2);
-        } else {
-          double a[3], b[3];
-          if (count == 7) {  // interior, valence 6: the ring is the row's columns 1..6
-            const double* p0 = c + 3 * static_cast<Eigen::Index>(column[1]);
-            const double* p1 = c + 3 * static_cast<Eigen::Index>(column[2]);
-            const double* p2 = c + 3 * static_cast<Eigen::Index>(column[3]);
-            const double* p3 = c + 3 * static_cast<Eigen::Index>(column[4]);
-            const double* p4 = c + 3 * static_cast<Eigen::Index>(column[5]);
-            const double* p5 = c + 3 * static_cast<Eigen::Index>(column[6]);
-            const double h = 0.8660254037844386;  // √3/2
-            for (int k = 0; k < 3; ++k) {
-              a[k] = (p0[k] - p3[k]) + 0.5 * ((p1[k] + p5[k]) - (p2[k] + p4[k]));
-              b[k] = h * ((p1[k] + p2[k]) - (p4[k] + p5[k]));
-            }
-          } else {
-            TangentsAt(coarse_tangents, regular_offset, c, v, a, b);
-          }
-          const double cs = rotations[2 * rotation], sn = rotations[2 * rotation + 1];
-          for (int k = 0; k < 3; ++k) {
-            t1[k] = cs * a[k] - sn * b[k];
-            t2[k] = cs * b[k] + sn * a[k];
-          }
-        }
-        for (int k = 0; k < 3; ++k) {
-          even_points[3 * static_cast<Eigen::Index>(v) + k] = s[k];
-          block.p[k][j] = s[k];
-          block.a[k][j] = t1[k];
-          block.b[k][j] = t2[k];
-        }
-      }
-      FramesOfBlock(size, &block);
-      WriteDetailed(block, size, d + 3 * static_cast<Eigen::Index>(first),
-                    out + 3 * static_cast<Eigen::Index>(first));
-    }
-  });
-
-  // Odd vertices: p = 3/8 (a + b) + 1/8 (P + Q) (Apply's order), tangents by the closed
-  // form of synthesis_plan.h on the coarse and even predicted points.
-  ForEachRowBlock(plan.odd_vertex_count, [&](int begin, int end) {
-    FusedBlock block;
-    for (int first = begin; first < end; first += kFusedBlock) {
-      const int size = std::min(kFusedBlock, end - first);
-      for (int j = 0; j < size; ++j) {
-        const int e = first + j;
-        const int m = nc + e;
-        const int* col = plan.odd_columns.data() + 8 * static_cast<Eigen::Index>(e);
-        const std::uint8_t rotation = plan.odd_rotation[e];
-        double t1[3], t2[3];
-        if (rotation == SynthesisPlan::kGeneral) {
-          const double* w = weights + weight_offsets[m];
-          double s[3] = {0.0, 0.0, 0.0};
-          for (int i = offsets[m]; i < offsets[m + 1]; ++i, ++w) {
-            const double* x = c + 3 * static_cast<Eigen::Index>(columns[i]);
-            s[0] += *w * x[0];
-            s[1] += *w * x[1];
-            s[2] += *w * x[2];
-          }
-          GeneralTangents(plan, col[0], c, t1, t2);
-          for (int k = 0; k < 3; ++k) block.p[k][j] = s[k];
-        } else {
-          const double* pa = c + 3 * static_cast<Eigen::Index>(col[0]);
-          const double* pb = c + 3 * static_cast<Eigen::Index>(col[1]);
-          const double* pp = c + 3 * static_cast<Eigen::Index>(col[2]);
-          const double* pq = c + 3 * static_cast<Eigen::Index>(col[3]);
-          const double* x1 = c + 3 * static_cast<Eigen::Index>(col[4]);
-          const double* x2 = c + 3 * static_cast<Eigen::Index>(col[5]);
-          const double* x3 = c + 3 * static_cast<Eigen::Index>(col[6]);
-          const double* x4 = c + 3 * static_cast<Eigen::Index>(col[7]);
-          const double* ea = even_points + 3 * static_cast<Eigen::Index>(col[0]);
-          const double* eb = even_points + 3 * static_cast<Eigen::Index>(col[1]);
-          const double cs = rotations[2 * rotation], sn = rotations[2 * rotation + 1];
-          const double h = 0.8660254037844386;  // √3/2
-          for (int k = 0; k < 3; ++k) {
-            block.p[k][j] = ((0.375 * pa[k] + 0.375 * pb[k]) + 0.125 * pp[k]) + 0.125 * pq[k];
-            const double a0 = (ea[k] - eb[k]) + 0.25 * (pa[k] - pb[k]) +
-                              0.0625 * ((x1[k] + x4[k]) - (x2[k] + x3[k]));
-            const double b0 = h * (0.75 * (pq[k] - pp[k]) + 0.125 * ((x1[k] + x2[k]) - (x3[k] + x4[k])));
-            t1[k] = cs * a0 - sn * b0;
-            t2[k] = cs * b0 + sn * a0;
-          }
-        }
-        for (int k = 0; k < 3; ++k) {
-          block.a[k][j] = t1[k];
-          block.b[k][j] = t2[k];
-        }
-      }
-      FramesOfBlock(size, &block);
-      WriteDetailed(block, size, d + 3 * static_cast<Eigen::Index>(nc + first),
-                    out + 3 * static_cast<Eigen::Index>(nc + first));
-    }
-  });
+  Positions even(plan.coarse_vertex_count, 3);
+  const SynthesisStep step{&plan,
+                           &hierarchy.RefinementStencil(level - 1),
+                           &coarse_tangents,
+                           coarse_tangents.PatternWeightOffset(6),
+                           coarse.data(),
+                           local.data(),
+                           even.data(),
+                           result->data()};
+  auto even_vertices = EvenVerticesBaseline;
+  auto odd_vertices = OddVerticesBaseline;
+#ifdef SUBFLOW_HAVE_AVX2_KERNELS
+  if (kernel == SynthesisKernel::kAvx2Fma || (kernel == SynthesisKernel::kBest && CpuHasAvx2Fma())) {
+    even_vertices = EvenVerticesAvx2Fma;
+    odd_vertices = OddVerticesAvx2Fma;
+  }
+#endif
+  ForEachRowBlock(plan.coarse_vertex_count,
+                  [&](int begin, int end) { even_vertices(step, begin, end); });
+  ForEachRowBlock(plan.odd_vertex_count,
+                  [&](int begin, int end) { odd_vertices(step, begin, end); });
 }
 
 Positions LimitNormals(const LoopHierarchy& hierarchy, int level,

@@ -62,8 +62,16 @@ void AddDetailsInLocalFrames(const LoopHierarchy& hierarchy, int level,
 // to rounding (p itself is computed with Apply's sums): the tangents of p come from the
 // coarse points through the tables of hierarchy.SynthesisPlanOf(level), so the odd rows of
 // p are never stored or gathered. `result` must not alias the inputs.
+//
+// The step runs in one of two instruction sets, with the same formulas: the x86-64
+// baseline (SSE2), and AVX2 with fused multiply-adds, which rounds the frames and F d
+// differently by a few ulps (p is rounded as Apply rounds it in both). kBest takes AVX2+FMA
+// when the CPU has both; asking for kAvx2Fma on a CPU without them throws.
+enum class SynthesisKernel { kBest, kBaseline, kAvx2Fma };
+bool SynthesisKernelAvailable(SynthesisKernel kernel);
 void RefineAndAddDetails(const LoopHierarchy& hierarchy, int level, const Positions& coarse,
-                         const Positions& local, Positions* result);
+                         const Positions& local, Positions* result,
+                         SynthesisKernel kernel = SynthesisKernel::kBest);
 
 // Limit normals only (#V×3 unit rows), same convention as LocalFrames::normal.
 Positions LimitNormals(const LoopHierarchy& hierarchy, int level,
