@@ -48,6 +48,7 @@ nlohmann::json RefinementJson(const solver::StereoRefinementOptions& o, const so
   for (const solver::RefinementLevelReport& l : result.levels)
     levels.push_back({{"level", l.level}, {"dof", l.dof}, {"patches", l.patches},
                       {"active_patches", l.active_patches}, {"active_fraction", l.active_fraction},
+                      {"windows", l.windows},
                       {"parameters", l.parameters}, {"residual_blocks", l.residual_blocks},
                       {"mean_increment", l.mean_increment}, {"iterations", l.iterations},
                       {"seconds", l.seconds}, {"solver_seconds", l.solver_seconds}});
@@ -60,6 +61,7 @@ nlohmann::json RefinementJson(const solver::StereoRefinementOptions& o, const so
   return {{"options",
            {{"coarsest_level", o.coarsest_level}, {"finest_level", o.finest_level},
             {"normal_only_from_level", o.normal_only_from_level}, {"window", o.window},
+            {"window_overlap", o.window_overlap},
             {"rounds", o.rounds}, {"max_iterations", o.max_iterations},
             {"linear_solver", o.linear_solver}, {"threads", o.threads},
             {"samples_per_pixel", o.samples_per_pixel}, {"min_density", o.min_density},

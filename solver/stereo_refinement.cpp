@@ -138,6 +138,19 @@ LevelSampling SampleLevel(const LoopHierarchy& hierarchy, int level, const Posit
   return result;
 }
 
+// The frame ranges [w0, w1] of the windows over `frames` frames: `window` frames each
+// (fewer at the end), consecutive ones sharing `overlap` frames.
+std::vector<std::pair<int, int>> Windows(int frames, int window, int overlap) {
+  std::vector<std::pair<int, int>> windows;
+  const int step = window - overlap;
+  for (int w0 = 0;; w0 += step) {
+    const int w1 = std::min(frames - 1, w0 + window - 1);
+    windows.emplace_back(w0, w1);
+    if (w1 == frames - 1) break;
+  }
+  return windows;
+}
+
 double MeanEdgeLength(const geometry::Faces& F, const Positions& V) {
   double sum = 0.0;
   for (Eigen::Index f = 0; f < F.rows(); ++f)
@@ -352,14 +365,16 @@ void LevelRefiner::Run(int level, const std::vector<char>& active_faces,
   report.active_patches = static_cast<int>(std::count(active_faces.begin(), active_faces.end(), 1));
   report.active_fraction = static_cast<double>(report.active_patches) / report.patches;
   std::vector<double> moved(hierarchy_.VertexCount(level), 0.0);
-  const int window = std::max(1, options_.window);
+  const auto windows = Windows(frames, options_.window, options_.window_overlap);
+  report.windows = static_cast<int>(windows.size());
   for (int round = 0; round < options_.rounds; ++round) {
     report.parameters = 0;
     report.residual_blocks = 0;
-    for (int w0 = 0; w0 < frames; w0 += window) {
-      const int w1 = std::min(frames - 1, w0 + window - 1);
+    for (std::size_t w = 0; w < windows.size(); ++w) {
+      const auto [w0, w1] = windows[w];
       SolveWindow(level, dof, w0, w1, sampling, tester, active_faces, h, &report, &moved);
-      images_.Release(w1);  // the next window needs frames ≥ w1 (its context frame w1)
+      // The next window needs its frames and its context frame before them.
+      if (w + 1 < windows.size()) images_.Release(windows[w + 1].first - 1);
       ProgressUpdate(progress, ++*progress_done);
     }
   }
@@ -715,6 +730,8 @@ void StereoRefinementOptions::Check() const {
   require(coarsest_level >= 0, "coarsest_level", "must be ≥ 0");
   require(normal_only_from_level >= 0, "normal_only_from_level", "must be ≥ 0");
   require(window >= 1, "window", "must be ≥ 1");
+  require(window_overlap >= 0 && window_overlap < window, "window_overlap",
+          "must satisfy 0 ≤ window_overlap < window");
   require(rounds >= 1, "rounds", "must be ≥ 1");
   require(max_iterations >= 1, "max_iterations", "must be ≥ 1");
   require(threads >= 0, "threads", "must be ≥ 0");
@@ -770,9 +787,9 @@ RefinementResult RefineStereo(const std::vector<vision::Camera>& cameras,
   FrameImages images(gray, silhouettes, static_cast<int>(cameras.size()), options.image_sigma);
 
   const int frames = static_cast<int>(control.size());
-  const int windows = (frames + options.window - 1) / options.window;
+  const std::size_t windows = Windows(frames, options.window, options.window_overlap).size();
   ProgressBegin(progress, "refinement",
-                static_cast<std::size_t>((finest_refined - options.coarsest_level + 1) * options.rounds * windows));
+                static_cast<std::size_t>(finest_refined - options.coarsest_level + 1) * options.rounds * windows);
   std::size_t done = 0;
   LevelRefiner refiner(cameras, hierarchy, bounds, options, images, trajectory, result.control, result);
   std::vector<char> active(hierarchy.FaceCount(options.coarsest_level), 1);

@@ -68,6 +68,11 @@ struct StereoRefinementOptions {
   // initialization and corrects the shape along the normals.
   int normal_only_from_level = 0;
   int window = 6;                  // frames solved jointly
+  // Frames shared by consecutive windows: the last `window_overlap` frames of a window are
+  // solved again, from their refined state, as the first frames of the next one, so that
+  // no frame is only ever refined at a window's edge (where the temporal terms see one
+  // side only). Must be < window. Windows advance by window − window_overlap frames.
+  int window_overlap = 0;
   // Visibility/sample updates per level (visibility is recomputed at every level anyway).
   int rounds = 1;
   int max_iterations = 8;          // Ceres iterations per round
@@ -114,6 +119,7 @@ struct RefinementLevelReport {
   double active_fraction = 0;  // active / all
   int parameters = 0;          // scalar unknowns over all windows and rounds (last round)
   int residual_blocks = 0;     // over all windows (last round)
+  int windows = 0;             // temporal windows solved per round
   double mean_increment = 0;   // mean |B e| over vertices and frames (world units)
   double seconds = 0;
   double solver_seconds = 0;   // inside ceres::Solve

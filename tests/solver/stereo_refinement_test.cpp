@@ -117,10 +117,36 @@ TEST(StereoRefinement, PerturbedShapeMovesBackTowardsTheTruth) {
   }
 }
 
+// Overlapping windows: with 2-frame windows sharing one frame, 3 frames take 2 windows and
+// the middle frame is solved in both; every frame is refined and moves back.
+TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
+  const RefinementScene& scene = Scene();
+  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const double before = scene.RmsDistanceToTruth(perturbed);
+  StereoRefinementOptions options = TestOptions();
+  options.window_overlap = 1;
+  options.finest_level = 0;
+  const RefinementResult result = scene.Refine(perturbed, 3, options);
+  ASSERT_EQ(result.levels.size(), 1u);
+  EXPECT_EQ(result.levels[0].windows, 2);
+  for (std::size_t f = 0; f < result.control.size(); ++f) {
+    EXPECT_GT(result.frames[f].stereo_pairs, 0) << "frame " << f;
+    EXPECT_LT(scene.RmsDistanceToTruth(result.control[f]), before) << "frame " << f;
+  }
+  options.window_overlap = 0;
+  options.max_iterations = 1;  // the window count does not depend on the solve
+  EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 2);  // [0, 1], [2]
+  options.window = 1;
+  EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 3);
+}
+
 TEST(StereoRefinement, RejectsBadInput) {
   const RefinementScene& scene = Scene();
   StereoRefinementOptions options = TestOptions();
   options.window = 0;
+  EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
+  options = TestOptions();
+  options.window_overlap = options.window;  // would never advance
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
   options = TestOptions();
   options.linear_solver = "magic";
