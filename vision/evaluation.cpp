@@ -6,6 +6,7 @@
 #include <memory>
 #include <numeric>
 
+#include <Eigen/Geometry>
 #include <tbb/parallel_for.h>
 
 #include "geometry/error.h"
@@ -41,14 +42,20 @@ std::vector<double> SampleDistances(const TriangleMesh& from, const ClosestPoint
 }
 
 // The motion of each result vertex's closest true material point from frame f to f + 1.
-Positions TrueMotion(const Positions& result_vertices, const ClosestPointTree& truth_tree,
-                     const TriangleMesh& truth_next) {
+// The true motion of the closest true point of every result vertex, and the unit normal
+// of the true face it lies on.
+Positions TrueMotion(const Positions& result_vertices, const TriangleMesh& truth,
+                     const ClosestPointTree& truth_tree, const TriangleMesh& truth_next,
+                     Positions* truth_normals) {
   const std::vector<geometry::SurfacePoint> closest = truth_tree.ClosestPoints(result_vertices);
   Positions motion(result_vertices.rows(), 3);
+  truth_normals->resize(result_vertices.rows(), 3);
   for (Eigen::Index i = 0; i < result_vertices.rows(); ++i) {
     const Eigen::Vector3d next =
         geometry::FacePoint(truth_next.V, truth_next.F, closest[i].face, closest[i].barycentric);
     motion.row(i) = (next - closest[i].point).transpose();
+    const auto corner = [&](int k) { return Eigen::Vector3d(truth.V.row(truth.F(closest[i].face, k))); };
+    truth_normals->row(i) = (corner(1) - corner(0)).cross(corner(2) - corner(0)).normalized().transpose();
   }
   return motion;
 }
@@ -135,6 +142,7 @@ EvaluationReport EvaluateSequence(int frame_count,
 
   std::vector<double> pooled_accuracy, pooled_epe;
   double completeness_sum = 0.0, chamfer_sum = 0.0, hausdorff = 0.0, motion_sum = 0.0;
+  double normal_error_sum = 0.0, tangential_error_sum = 0.0;
   ProgressBegin(progress, "eval", static_cast<std::size_t>(frame_count));
   for (int f = 0; f < frame_count; ++f) {
     FrameScores scores;
@@ -168,16 +176,25 @@ EvaluationReport EvaluateSequence(int frame_count,
                    has_motion ? "missing, but present at frame 0" : "present, but missing at frame 0");
       const Positions recovered = has_motion ? *result.motion : Positions(result_next.mesh.V - result.mesh.V);
       SUBFLOW_CHECK(recovered.rows() == result.mesh.V.rows(), "one motion vector per vertex");
-      const Positions true_motion = TrueMotion(result.mesh.V, truth_tree, truth_next);
+      Positions truth_normals;
+      const Positions true_motion = TrueMotion(result.mesh.V, truth, truth_tree, truth_next, &truth_normals);
       std::vector<double> epe(static_cast<std::size_t>(true_motion.rows()));
-      double frame_motion_sum = 0.0;
+      double frame_motion_sum = 0.0, frame_normal_sum = 0.0, frame_tangential_sum = 0.0;
       for (Eigen::Index i = 0; i < true_motion.rows(); ++i) {
-        epe[i] = (recovered.row(i) - true_motion.row(i)).norm();
+        const Eigen::RowVector3d error = recovered.row(i) - true_motion.row(i);
+        const double along_normal = error.dot(truth_normals.row(i));
+        epe[i] = error.norm();
         frame_motion_sum += true_motion.row(i).norm();
+        frame_normal_sum += std::abs(along_normal);
+        frame_tangential_sum += (error - along_normal * truth_normals.row(i)).norm();
       }
       FlowScores& flow = scores.flow;
       flow.evaluated = true;
       flow.epe_mean = Mean(epe);
+      flow.epe_normal_mean = frame_normal_sum / static_cast<double>(epe.size());
+      flow.epe_tangential_mean = frame_tangential_sum / static_cast<double>(epe.size());
+      normal_error_sum += frame_normal_sum;
+      tangential_error_sum += frame_tangential_sum;
       flow.true_motion_mean = frame_motion_sum / static_cast<double>(epe.size());
       flow.epe_relative = flow.true_motion_mean > 0.0 ? flow.epe_mean / flow.true_motion_mean : 0.0;
       motion_sum += frame_motion_sum;
@@ -211,6 +228,8 @@ EvaluationReport EvaluateSequence(int frame_count,
     overall.flow.epe_relative =
         overall.flow.true_motion_mean > 0.0 ? overall.flow.epe_mean / overall.flow.true_motion_mean : 0.0;
     overall.flow.epe_median = Percentile(pooled_epe, 50.0);
+    overall.flow.epe_normal_mean = normal_error_sum / static_cast<double>(pooled_epe.size());
+    overall.flow.epe_tangential_mean = tangential_error_sum / static_cast<double>(pooled_epe.size());
   }
   return report;
 }

@@ -49,6 +49,9 @@ struct SurfaceScores {
 struct FlowScores {
   bool evaluated = false;  // false at the last frame
   double epe_mean = 0.0, epe_median = 0.0, true_motion_mean = 0.0, epe_relative = 0.0;
+  // Mean magnitude of the error's component along the true surface normal (the part a
+  // shape error makes) and of its component in the tangent plane (sliding along the surface).
+  double epe_normal_mean = 0.0, epe_tangential_mean = 0.0;
 };
 
 struct FrameScores {

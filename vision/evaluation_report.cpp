@@ -34,7 +34,9 @@ nlohmann::json ScoresJson(const FrameScores& scores) {
     json["flow"] = {{"epe_mean", scores.flow.epe_mean},
                     {"epe_median", scores.flow.epe_median},
                     {"true_motion_mean", scores.flow.true_motion_mean},
-                    {"epe_relative", scores.flow.epe_relative}};
+                    {"epe_relative", scores.flow.epe_relative},
+                    {"epe_normal_mean", scores.flow.epe_normal_mean},
+                    {"epe_tangential_mean", scores.flow.epe_tangential_mean}};
   } else {
     json["flow"] = nullptr;
   }
@@ -47,10 +49,11 @@ std::string ScoresLine(const std::string& label, const FrameScores& s) {
                 s.surface.completeness, s.surface.chamfer, s.surface.hausdorff);
   std::string text = line;
   if (s.flow.evaluated) {
-    std::snprintf(line, sizeof(line), " %11.4g %11.4g %11.4g %8.4f", s.flow.epe_mean, s.flow.epe_median,
-                  s.flow.true_motion_mean, s.flow.epe_relative);
+    std::snprintf(line, sizeof(line), " %11.4g %11.4g %11.4g %8.4f %11.4g %11.4g", s.flow.epe_mean,
+                  s.flow.epe_median, s.flow.true_motion_mean, s.flow.epe_relative, s.flow.epe_normal_mean,
+                  s.flow.epe_tangential_mean);
   } else {
-    std::snprintf(line, sizeof(line), " %11s %11s %11s %8s", "-", "-", "-", "-");
+    std::snprintf(line, sizeof(line), " %11s %11s %11s %8s %11s %11s", "-", "-", "-", "-", "-", "-");
   }
   return text + line + "\n";
 }
@@ -133,9 +136,10 @@ EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
 
 std::string EvaluationReport::Table() const {
   char header[512];
-  std::snprintf(header, sizeof(header), "%-8s %11s %8s %11s %11s %11s %11s %11s %8s\n", "frame",
+  std::snprintf(header, sizeof(header), "%-8s %11s %8s %11s %11s %11s %11s %11s %8s %11s %11s\n", "frame",
                 ("accuracy" + std::to_string(static_cast<int>(accuracy_percentile))).c_str(), "complete",
-                "chamfer", "hausdorff", "epe_mean", "epe_median", "true_mean", "epe_rel");
+                "chamfer", "hausdorff", "epe_mean", "epe_median", "true_mean", "epe_rel", "epe_normal",
+                "epe_tangent");
   std::string table = header;
   for (const FrameScores& frame : frames) table += ScoresLine(FrameFileName(frame.frame).substr(0, 6), frame);
   table += ScoresLine("overall", overall);

@@ -156,6 +156,34 @@ TEST(Evaluation, FlowIsMeasuredAtTheClosestMaterialPoint) {
   EXPECT_NEAR(none.overall.flow.epe_relative, 1.0, 1e-9);
 }
 
+TEST(Evaluation, FlowErrorSplitsIntoNormalAndTangentialParts) {
+  // A flat 5×5 grid in z = 0 moving by (1, 2, 0) mm per frame; the result is the true
+  // grid whose vx vy vz err by δ along z (the normal) or along x (in the plane).
+  TriangleMesh grid;
+  grid.V.resize(25, 3);
+  grid.F.resize(32, 3);
+  for (int i = 0; i < 25; ++i) grid.V.row(i) << 0.01 * (i % 5), 0.01 * (i / 5), 0.0;
+  for (int y = 0, f = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) {
+      const int a = 5 * y + x;
+      grid.F.row(f++) << a, a + 1, a + 6;
+      grid.F.row(f++) << a, a + 6, a + 5;
+    }
+  const Eigen::RowVector3d step(0.001, 0.002, 0.0);
+  const auto truth = [&](int f) { return TriangleMesh{grid.V.rowwise() + f * step, grid.F}; };
+  const double delta = 1e-4;
+  for (int axis : {2, 0}) {
+    Positions motion = Positions::Zero(25, 3).rowwise() + step;
+    motion.col(axis).array() += delta;
+    const EvaluationReport report =
+        EvaluateSequence(2, truth, [&](int f) { return EvaluationFrame{truth(f), motion}; }, SmallOptions());
+    const FlowScores& flow = report.overall.flow;
+    EXPECT_NEAR(flow.epe_mean, delta, 1e-12);
+    EXPECT_NEAR(flow.epe_normal_mean, axis == 2 ? delta : 0.0, 1e-12) << "axis " << axis;
+    EXPECT_NEAR(flow.epe_tangential_mean, axis == 2 ? 0.0 : delta, 1e-12) << "axis " << axis;
+  }
+}
+
 TEST(Evaluation, SurfaceSamplesAreAreaWeightedAndDeterministic) {
   // Two triangles of areas 1 and 3: a quarter of the samples on the first.
   TriangleMesh mesh;
