@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 
 #include <Eigen/Geometry>
 
@@ -185,25 +187,24 @@ inline void GeneralTangents(const SynthesisPlan& plan, int row, const double* co
 //
 // Per block of vertices, two phases:
 //  1. per vertex, gather its few source points and form the predicted point p and the
-//     unrotated tangents (a, b) of synthesis_plan.h, with the three coordinates of a point
-//     in one vector value (x, y, z, 0) — one AVX register, or two SSE2 ones — stored
-//     structure-of-arrays with the vertex's rotation (cos φ, sin φ);
-//  2. element-wise over the block: rotate the tangents, compute the frame (as FramesOfBlock:
-//     degenerate lanes selected, not branched to) and write p + d_n n + d_r r + d_q q; the
-//     compiler vectorizes this loop across vertices.
+//     tangents (t1, t2) of synthesis_plan.h (rotated), the three coordinates of a point in
+//     one vector value (x, y, z, ·) — one AVX register, or two SSE2 ones — stored
+//     structure-of-arrays;
+//  2. element-wise over the block, in loops the compiler vectorizes across vertices: the
+//     frame (as FramesOfBlock: degenerate lanes selected, not branched to) and the output
+//     row p + d_n n + d_r r + d_q q.
 // Both phases exist twice: for the x86-64 baseline (SSE2) and, chosen at run time when the
-// CPU has them, for AVX2 with FMA (fused multiply-adds in phase 2 only, so p, and hence
-// synthesis with zero details, is rounded exactly as PointStencil::Apply rounds it).
-constexpr int kSynthesisBlock = 128;  // 11 doubles × 128 = 11 KiB, within L1
+// CPU has them, for AVX2 with FMA (fused multiply-adds in phase 2 only; this file is
+// compiled with -ffp-contract=off, so p, and hence synthesis with zero details, is rounded
+// exactly as PointStencil::Apply rounds it in both).
+constexpr int kSynthesisBlock = 128;  // 14 doubles × 128 = 14 KiB, within L1
 
 struct SynthesisBlock {
   alignas(64) double p[3][kSynthesisBlock];  // predicted points
-  alignas(64) double a[3][kSynthesisBlock];  // tangents before the rotation
+  alignas(64) double a[3][kSynthesisBlock];  // tangents t1, t2
   alignas(64) double b[3][kSynthesisBlock];
-  alignas(64) double cos[kSynthesisBlock];  // rotation (cos φ, sin φ)
-  alignas(64) double sin[kSynthesisBlock];
-  alignas(64) double n[3][kSynthesisBlock];       // scratch of phase 2: the normal
-  alignas(64) double length[2][kSynthesisBlock];  // and 1/|t1 × t2|, 1/|t1| (squared first)
+  alignas(64) double n[3][kSynthesisBlock];       // scratch of phase 2: t1 × t2
+  alignas(64) double length[2][kSynthesisBlock];  // |t1 × t2|, |t1|
 };
 
 // The inputs and outputs of one step, shared by the block kernels.
@@ -215,23 +216,37 @@ struct SynthesisStep {
   const double* coarse;                 // c, #V(level − 1)×3
   const double* details;                // d, #V(level)×3
   double* even_points;                  // p of the even vertices (written by the even pass)
+                                        // (coarse and even_points: one padding row each)
   double* out;                          // result, #V(level)×3
 };
 
-// A point as one vector value (x, y, z, 0) (GCC/Clang vector extension).
+// A point as one vector value (x, y, z, ·) (GCC/Clang vector extension); the fourth lane
+// is whatever follows the point in memory, computed with but never stored.
 typedef double Point4 __attribute__((vector_size(32)));
 
 #define SUBFLOW_KERNEL inline __attribute__((always_inline))
 
+// Point `index` of a #V×3 array that has (at least) one more double after its last row.
 SUBFLOW_KERNEL Point4 LoadPoint(const double* points, int index) {
-  const double* x = points + 3 * static_cast<Eigen::Index>(index);
-  return Point4{x[0], x[1], x[2], 0.0};
+  Point4 x;
+  std::memcpy(&x, points + 3 * static_cast<Eigen::Index>(index), sizeof x);
+  return x;
 }
 
 SUBFLOW_KERNEL void StoreColumn(double (*soa)[kSynthesisBlock], int j, Point4 value) {
   soa[0][j] = value[0];
   soa[1][j] = value[1];
   soa[2][j] = value[2];
+}
+
+// The tangents t1 = cos φ a − sin φ b, t2 = cos φ b + sin φ a of rotation `rotation` of the
+// plan's table (a, b themselves for kGeneral) into column j of block->a, block->b.
+SUBFLOW_KERNEL void StoreRotated(const double* rotations, std::uint8_t rotation, Point4 a,
+                                 Point4 b, int j, SynthesisBlock* block) {
+  const int index = rotation == SynthesisPlan::kGeneral ? 0 : rotation;
+  const double cs = rotations[2 * index], sn = rotations[2 * index + 1];
+  StoreColumn(block->a, j, cs * a - sn * b);
+  StoreColumn(block->b, j, cs * b + sn * a);
 }
 
 // a · b + c, fused (one rounding) in the FMA kernels.
@@ -242,19 +257,17 @@ SUBFLOW_KERNEL double MulAdd(double a, double b, double c) {
 }
 
 // Phase 2 over the first `size` vertices of the block; d and out start at its first vertex.
-// Three element-wise loops (as FramesOfBlock): the rotated tangents' cross product and
-// squared lengths with the degenerate lanes selected; the reciprocal lengths; the frame
-// and the output row.
+// Two element-wise loops, each with some of the slow square roots and divisions beside
+// other arithmetic: the cross product c = t1 × t2 and the lengths |c|, |t1| with the
+// degenerate lanes selected (as FramesOfBlock, but the square roots are taken before the
+// selection so that the loop has no branch); then the frame and the output row. The two
+// reciprocal lengths take one division: 1/|c| = |t1| e, 1/|t1| = |c| e, e = 1/(|c| |t1|).
 template <bool kFma>
 SUBFLOW_KERNEL void FinishBlock(SynthesisBlock* block, int size, const double* __restrict d,
                                 double* __restrict out) {
   for (int j = 0; j < size; ++j) {
-    const double cs = block->cos[j], sn = block->sin[j];
-    double t1[3], t2[3];
-    for (int k = 0; k < 3; ++k) {
-      t1[k] = MulAdd<kFma>(cs, block->a[k][j], -(sn * block->b[k][j]));
-      t2[k] = MulAdd<kFma>(cs, block->b[k][j], sn * block->a[k][j]);
-    }
+    const double t1[3] = {block->a[0][j], block->a[1][j], block->a[2][j]};
+    const double t2[3] = {block->b[0][j], block->b[1][j], block->b[2][j]};
     const double x = MulAdd<kFma>(t1[1], t2[2], -(t1[2] * t2[1]));
     const double y = MulAdd<kFma>(t1[2], t2[0], -(t1[0] * t2[2]));
     const double z = MulAdd<kFma>(t1[0], t2[1], -(t1[1] * t2[0]));
@@ -262,24 +275,26 @@ SUBFLOW_KERNEL void FinishBlock(SynthesisBlock* block, int size, const double* _
     const double a_2 = MulAdd<kFma>(t1[0], t1[0], MulAdd<kFma>(t1[1], t1[1], t1[2] * t1[2]));
     const double b_2 = MulAdd<kFma>(t2[0], t2[0], MulAdd<kFma>(t2[1], t2[1], t2[2] * t2[2]));
     const bool regular = cross2 > kDegenerateSine * kDegenerateSine * a_2 * b_2;  // false on NaN
-    block->n[0][j] = regular ? x : 0.0;
+    block->n[0][j] = regular ? x : 0.0;  // c
     block->n[1][j] = regular ? y : 0.0;
     block->n[2][j] = regular ? z : 1.0;
-    block->a[0][j] = regular ? t1[0] : 1.0;  // a becomes r
+    block->a[0][j] = regular ? t1[0] : 1.0;  // t1, or e_x
     block->a[1][j] = regular ? t1[1] : 0.0;
     block->a[2][j] = regular ? t1[2] : 0.0;
-    block->length[0][j] = regular ? cross2 : 1.0;
-    block->length[1][j] = regular ? a_2 : 1.0;
+    const double cross_length = std::sqrt(cross2), a_length = std::sqrt(a_2);
+    block->length[0][j] = regular ? cross_length : 1.0;
+    block->length[1][j] = regular ? a_length : 1.0;
   }
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < size; ++j) block->length[i][j] = 1.0 / std::sqrt(block->length[i][j]);
   for (int j = 0; j < size; ++j) {
-    const double n[3] = {block->n[0][j] * block->length[0][j],
-                         block->n[1][j] * block->length[0][j],
-                         block->n[2][j] * block->length[0][j]};
-    const double r[3] = {block->a[0][j] * block->length[1][j],
-                         block->a[1][j] * block->length[1][j],
-                         block->a[2][j] * block->length[1][j]};
+    const double cross_length = block->length[0][j];
+    const double a_length = block->length[1][j];
+    const double inverse_product = 1.0 / (cross_length * a_length);
+    const double inverse_cross = a_length * inverse_product;
+    const double inverse_a = cross_length * inverse_product;
+    const double n[3] = {block->n[0][j] * inverse_cross, block->n[1][j] * inverse_cross,
+                         block->n[2][j] * inverse_cross};
+    const double r[3] = {block->a[0][j] * inverse_a, block->a[1][j] * inverse_a,
+                         block->a[2][j] * inverse_a};
     const double q[3] = {MulAdd<kFma>(n[1], r[2], -(n[2] * r[1])),
                          MulAdd<kFma>(n[2], r[0], -(n[0] * r[2])),
                          MulAdd<kFma>(n[0], r[1], -(n[1] * r[0]))};
@@ -339,11 +354,7 @@ SUBFLOW_KERNEL void GatherEvenBlock(const SynthesisStep& step, int first, int si
     double* even = step.even_points + 3 * static_cast<Eigen::Index>(v);
     even[0] = s[0], even[1] = s[1], even[2] = s[2];
     StoreColumn(block->p, j, s);
-    StoreColumn(block->a, j, a);
-    StoreColumn(block->b, j, b);
-    const int rotation_index = rotation == SynthesisPlan::kGeneral ? 0 : rotation;
-    block->cos[j] = plan.rotations[2 * rotation_index];
-    block->sin[j] = plan.rotations[2 * rotation_index + 1];
+    StoreRotated(plan.rotations.data(), rotation, a, b, j, block);
   }
 }
 
@@ -384,11 +395,7 @@ SUBFLOW_KERNEL void GatherOddBlock(const SynthesisStep& step, int first, int siz
       b = h * (0.75 * (pq - pp) + 0.125 * ((x1 + x2) - (x3 + x4)));
     }
     StoreColumn(block->p, j, p);
-    StoreColumn(block->a, j, a);
-    StoreColumn(block->b, j, b);
-    const int rotation_index = rotation == SynthesisPlan::kGeneral ? 0 : rotation;
-    block->cos[j] = rotations[2 * rotation_index];
-    block->sin[j] = rotations[2 * rotation_index + 1];
+    StoreRotated(rotations, rotation, a, b, j, block);
   }
 }
 
@@ -563,15 +570,21 @@ void RefineAndAddDetails(const LoopHierarchy& hierarchy, int level, const Positi
   const SynthesisPlan& plan = hierarchy.SynthesisPlanOf(level);
   const PointStencil& coarse_tangents = hierarchy.LimitTangentStencil(level - 1);
   result->resize(hierarchy.VertexCount(level), 3);
-  // The even predicted points p(v) = (C c)(v), v < #V(level − 1): the odd tangents use them.
-  Positions even(plan.coarse_vertex_count, 3);
+  // The coarse points, and the even predicted points p(v) = (C c)(v), v < #V(level − 1)
+  // (the odd tangents use them), both with a padding row for LoadPoint.
+  const Eigen::Index nc = plan.coarse_vertex_count;
+  const std::unique_ptr<double[]> padded_coarse(new double[3 * (nc + 1)]),
+      even(new double[3 * (nc + 1)]);  // uninitialized: all but the padding is written
+  std::copy(coarse.data(), coarse.data() + 3 * nc, padded_coarse.get());
+  std::fill(padded_coarse.get() + 3 * nc, padded_coarse.get() + 3 * (nc + 1), 0.0);
+  std::fill(even.get() + 3 * nc, even.get() + 3 * (nc + 1), 0.0);
   const SynthesisStep step{&plan,
                            &hierarchy.RefinementStencil(level - 1),
                            &coarse_tangents,
                            coarse_tangents.PatternWeightOffset(6),
-                           coarse.data(),
+                           padded_coarse.get(),
                            local.data(),
-                           even.data(),
+                           even.get(),
                            result->data()};
   auto even_vertices = EvenVerticesBaseline;
   auto odd_vertices = OddVerticesBaseline;

@@ -200,24 +200,65 @@ TEST(MultiresShape, RejectsControlPointsOfTheWrongSize) {
 
 // The hot path (RefineAndAddDetails: tangents of the predicted points from the coarse
 // points, synthesis_plan.h) agrees with refining, then framing the predicted points, on a
-// closed mesh with valence-5 vertices and on an open one (general rows at the boundary).
+// closed mesh with valence-5 vertices and on an open one (general rows at the boundary),
+// in each instruction set the CPU offers. The two paths round differently (sums in another
+// order, fused multiply-adds on AVX2): ~1e-15 on these O(1) coordinates, 1e-13 leaves room.
 TEST(MultiresShape, FusedSynthesisMatchesRefineThenFrame) {
   const Bumpy bumpy;
   const TriangleMesh patch = GridPatch(4, 3);
   const LoopHierarchy open(patch.F, patch.vertex_count(), 3);
   const Positions open_finest = AddNoise(open.Refine(AddNoise(patch.V, 0.2, 3), 0, 3), 0.05, 4);
-  for (const auto& [hierarchy, finest] :
-       {std::pair<const LoopHierarchy*, const Positions*>{&bumpy.hierarchy, &bumpy.finest},
-        std::pair<const LoopHierarchy*, const Positions*>{&open, &open_finest}}) {
-    const MultiresShape shape = MultiresShape::Analyze(*hierarchy, *finest);
-    Positions c = shape.base();
-    for (int level = 1; level <= 3; ++level) {
-      Positions predicted, expected, fused;
-      hierarchy->RefinementStencil(level - 1).Apply(c, &predicted);
-      AddDetailsInLocalFrames(*hierarchy, level, predicted, shape.Detail(level), &expected);
-      RefineAndAddDetails(*hierarchy, level, c, shape.Detail(level), &fused);
-      EXPECT_LT((fused - expected).cwiseAbs().maxCoeff(), 1e-13) << "level " << level;
-      c = expected;
+  for (const SynthesisKernel kernel : {SynthesisKernel::kBaseline, SynthesisKernel::kAvx2Fma}) {
+    if (!SynthesisKernelAvailable(kernel)) continue;
+    for (const auto& [hierarchy, finest] :
+         {std::pair<const LoopHierarchy*, const Positions*>{&bumpy.hierarchy, &bumpy.finest},
+          std::pair<const LoopHierarchy*, const Positions*>{&open, &open_finest}}) {
+      const MultiresShape shape = MultiresShape::Analyze(*hierarchy, *finest);
+      Positions c = shape.base();
+      for (int level = 1; level <= 3; ++level) {
+        Positions predicted, expected, fused;
+        hierarchy->RefinementStencil(level - 1).Apply(c, &predicted);
+        AddDetailsInLocalFrames(*hierarchy, level, predicted, shape.Detail(level), &expected);
+        RefineAndAddDetails(*hierarchy, level, c, shape.Detail(level), &fused, kernel);
+        EXPECT_LT((fused - expected).cwiseAbs().maxCoeff(), 1e-13)
+            << "level " << level << ", kernel " << static_cast<int>(kernel);
+        c = expected;
+      }
+    }
+  }
+}
+
+// The baseline (SSE2) and AVX2+FMA kernels of the synthesis step compute the same thing:
+// on a finer mesh (4 levels, 40962 vertices, so that the step runs in parallel blocks too)
+// they agree to 1e-12 relative to the coordinates' size (rounding only: FMA rounds once
+// where the baseline rounds twice). With zero details both give plain refinement exactly:
+// the predicted points are rounded as PointStencil::Apply rounds them, in both.
+TEST(MultiresShape, SynthesisKernelsAgree) {
+  if (!SynthesisKernelAvailable(SynthesisKernel::kAvx2Fma))
+    GTEST_SKIP() << "this CPU has no AVX2+FMA; only the baseline kernel runs";
+  const TriangleMesh base = MakeIcosphere(2);
+  const LoopHierarchy hierarchy(base.F, base.vertex_count(), 4);
+  const Positions finest =
+      AddNoise(hierarchy.Refine(AddNoise(base.V, 0.05, 6), 0, 4), 0.01, 7);
+  const MultiresShape shape = MultiresShape::Analyze(hierarchy, finest);
+  const MultiresShape smooth(hierarchy, base.V);
+  for (const MultiresShape* s : {&shape, &smooth}) {
+    Positions baseline = s->base(), avx2 = s->base(), next;
+    for (int level = 1; level <= 4; ++level) {
+      RefineAndAddDetails(hierarchy, level, baseline, s->Detail(level), &next,
+                          SynthesisKernel::kBaseline);
+      baseline.swap(next);
+      RefineAndAddDetails(hierarchy, level, avx2, s->Detail(level), &next,
+                          SynthesisKernel::kAvx2Fma);
+      avx2.swap(next);
+    }
+    const double scale = baseline.cwiseAbs().maxCoeff();
+    if (s == &smooth) {
+      EXPECT_EQ((baseline - avx2).cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_EQ((baseline - hierarchy.Refine(base.V, 0, 4)).cwiseAbs().maxCoeff(), 0.0);
+    } else {
+      EXPECT_LT((baseline - avx2).cwiseAbs().maxCoeff(), 1e-12 * scale);
+      EXPECT_LT((baseline - finest).cwiseAbs().maxCoeff(), 1e-10);
     }
   }
 }
