@@ -42,11 +42,15 @@ ceres::LinearSolverType ParseLinearSolver(const std::string& name) {
                           "sparse_schur, dense_qr");
 }
 
-// r = Σ_b A_b e_b: membrane, temporal second differences and damping of the increments.
+// r = Σ_b A_b e_b + r0: membrane and damping of the increments, temporal second
+// differences of the trajectories (r0: those of the current ones).
 class LinearResidualCost final : public ceres::CostFunction {
  public:
-  explicit LinearResidualCost(std::vector<Eigen::MatrixXd> blocks) : blocks_(std::move(blocks)) {
+  explicit LinearResidualCost(std::vector<Eigen::MatrixXd> blocks, Eigen::VectorXd offset = {})
+      : blocks_(std::move(blocks)), offset_(std::move(offset)) {
     set_num_residuals(static_cast<int>(blocks_.front().rows()));
+    if (offset_.size() == 0) offset_ = Eigen::VectorXd::Zero(num_residuals());
+    SUBFLOW_CHECK(offset_.size() == num_residuals(), "offset does not match the residuals");
     for (const Eigen::MatrixXd& A : blocks_)
       mutable_parameter_block_sizes()->push_back(static_cast<int>(A.cols()));
   }
@@ -54,7 +58,7 @@ class LinearResidualCost final : public ceres::CostFunction {
                 double** jacobians) const override {
     const int rows = num_residuals();
     Eigen::Map<Eigen::VectorXd> r(residuals, rows);
-    r.setZero();
+    r = offset_;
     for (std::size_t b = 0; b < blocks_.size(); ++b) {
       const Eigen::MatrixXd& A = blocks_[b];
       r += A * Eigen::Map<const Eigen::VectorXd>(parameters[b], A.cols());
@@ -67,6 +71,7 @@ class LinearResidualCost final : public ceres::CostFunction {
 
  private:
   std::vector<Eigen::MatrixXd> blocks_;
+  Eigen::VectorXd offset_;
 };
 
 // The samples of one level: a pattern inside every face of level ℓ, their level-ℓ limit
@@ -561,12 +566,29 @@ void LevelRefiner::SolveWindow(int level, int dof, int w0, int w1, const LevelSa
         problem.AddResidualBlock(new LinearResidualCost(std::move(A)), nullptr, blocks);
       }
       if (options_.temporal_smoothness > 0 && t > 0 && t + 1 < frames) {
+        // Second difference of the trajectory: of the base control point (world xyz) at
+        // level 0, of the detail in its local frame (n, r, q) above, which a rigid motion
+        // leaves unchanged. Neighbouring frames outside the window count with their
+        // current (already refined) values.
         const double w = options_.temporal_smoothness * inverse_h;
-        std::vector<Eigen::MatrixXd> A{w * B(t - 1, v), -2.0 * w * B(t, v), w * B(t + 1, v)};
+        std::vector<Eigen::MatrixXd> A;
+        Eigen::VectorXd offset;
+        if (level == 0) {
+          A = {w * B(t - 1, v), -2.0 * w * B(t, v), w * B(t + 1, v)};
+          offset = w * (states.at(t - 1).level_control.row(v) - 2.0 * states.at(t).level_control.row(v) +
+                        states.at(t + 1).level_control.row(v)).transpose();
+        } else {
+          const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(dof, dof);
+          A = {w * I, -2.0 * w * I, w * I};
+          const auto detail = [&](int frame) {
+            return trajectory_[frame].Detail(level).row(v).leftCols(dof).transpose();
+          };
+          offset = w * (detail(t - 1) - 2.0 * detail(t) + detail(t + 1));
+        }
         std::vector<double*> blocks;
         for (int frame : {t - 1, t, t + 1})
           blocks.push_back(states.at(frame).increments.data() + static_cast<std::ptrdiff_t>(v) * dof);
-        problem.AddResidualBlock(new LinearResidualCost(std::move(A)), nullptr, blocks);
+        problem.AddResidualBlock(new LinearResidualCost(std::move(A), std::move(offset)), nullptr, blocks);
       }
       if (options_.damping > 0) {
         std::vector<Eigen::MatrixXd> A{Eigen::MatrixXd::Identity(dof, dof) * (options_.damping * inverse_h)};

@@ -26,7 +26,9 @@
 //     hulls);
 //   * regularization, in units of the level's mean edge length h: membrane on the
 //     increments (B_v e_v − mean of the neighbours), temporal second differences of the
-//     increments (smooth corrections of the trajectories), and a small damping;
+//     trajectories (of the base control points in world coordinates; of the details in
+//     their local frames, which a rigid motion leaves unchanged, so only non-rigid
+//     acceleration is penalized), and a small damping;
 //   * bounds: |e| ≤ max_step · h per component, and, for the normal-only parametrization,
 //     the working volume (the paper's inequality constraints).
 // NCC blocks use a Cauchy loss (occlusions the z-buffer misses, specularities).
