@@ -48,6 +48,7 @@ nlohmann::json SilhouetteOptionsJson(const vision::SilhouetteOptions& o) {
           {"background_method", vision::ToString(o.background_method)},
           {"background_open_radius", o.background_open_radius},
           {"background_min_threshold", o.background_min_threshold},
+          {"background_contour_fraction", o.background_contour_fraction},
           {"motion_sigma", o.motion_sigma},
           {"motion_lambda", o.motion_lambda},
           {"motion_window", o.motion_window},
@@ -140,6 +141,7 @@ nlohmann::json ShapeInitReport(const vision::Dataset& dataset, const solver::Sha
                             {"max_distance", level.max_distance},
                             {"misses", level.misses}});
     frames.push_back({{"frame", frame.frame},
+                      {"hull_from_frame", frame.hull_from_frame},
                       {"voxel_resolution", frame.carving.resolution},
                       {"max_misses", frame.carving.max_misses},
                       {"carved_voxels", frame.carving.carved_voxels},

@@ -24,13 +24,29 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
                   "Voxels along the longest axis of the working volume (0 = automatic, ~2 px per voxel)")
       ->capture_default_str();
   sub->add_option("--min-cameras", o->carving.min_cameras,
-                  "Cameras that must see and support a voxel")->capture_default_str();
-  sub->add_option("--lambda", o->silhouettes.motion_lambda, "λ of the motion evidence (eq. 23)")
-      ->capture_default_str();
+                  "Cameras that must see and support a voxel (at least 1)")
+      ->capture_default_str()->check(CLI::Range(1, 1000));
+  sub->add_option("--max-misses", o->carving.max_misses,
+                  "Cameras that see a voxel without supporting it, tolerated before it is carved "
+                  "(-1 = automatic: 0 for masks and background differences, 1 when motion evidence is used)")
+      ->capture_default_str()->check(CLI::Range(-1, 1000));
+  sub->add_option("--evidence-threshold", o->carving.evidence_threshold,
+                  "Fraction of a voxel's footprint that must be object for a camera to support it, "
+                  "in (0, 1]; small = conservative hull")
+      ->capture_default_str()->check(CLI::Range(1e-6, 1.0));
+  sub->add_option("--footprint-margin", o->carving.footprint_margin,
+                  "Pixels added on each side of a voxel's footprint for its evidence, in [0, 100]")
+      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
+  sub->add_option("--lambda", o->silhouettes.motion_lambda, "λ of the motion evidence (eq. 23), > 0")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  sub->add_option("--motion-window", o->silhouettes.motion_window,
+                  "Half-width of the frame window over which motion evidence is accumulated")
+      ->capture_default_str()->check(CLI::Range(0, 100));
   sub->add_option("--motion-threshold", o->silhouettes.motion_threshold,
                   "Threshold of the motion evidence (< 0 = automatic, Otsu)")->capture_default_str();
   sub->add_option("--background-threshold", o->silhouettes.background_threshold,
-                  "Threshold of the background difference (< 0 = automatic, triangle)")->capture_default_str();
+                  "Threshold of the background difference, below 1 (< 0 = automatic, triangle)")
+      ->capture_default_str()->check(CLI::Range(-1e9, 0.999999));
 }
 
 void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o) {

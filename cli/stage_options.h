@@ -16,7 +16,9 @@ namespace subflow::cli {
 void AddDatasetAndOutput(CLI::App* app, std::string* dataset, std::string* out, bool* overwrite);
 
 // --evidence, --levels, --base-faces, --reference-frame, --first-frame, --frames,
-// --resolution, --min-cameras, --lambda, --motion-threshold, --background-threshold.
+// --resolution, --min-cameras, --max-misses, --evidence-threshold, --footprint-margin,
+// --lambda, --motion-window, --motion-threshold, --background-threshold (out-of-range values
+// are rejected naming the flag).
 void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::string* evidence);
 
 // --motion-smoothness, --hull-weight.

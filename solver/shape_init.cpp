@@ -1,6 +1,9 @@
 #include "solver/shape_init.h"
 
+#include <algorithm>
 #include <chrono>
+#include <string>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
@@ -12,6 +15,40 @@ namespace {
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Frames without evidence take the hull and carving figures of the nearest frame with
+// evidence (the earlier one on a tie), with a warning; an error when no frame has any.
+void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std::vector<bool>& has_evidence,
+                                      int min_cameras, std::vector<FrameShapeInit>* frames) {
+  const int count = static_cast<int>(frames->size());
+  if (std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end())
+    ThrowError(dataset.directory(),
+               "frames " + std::to_string(frames->front().frame) + ".." + std::to_string(frames->back().frame),
+               "no masks, no background, and no motion: cannot find the object (motion evidence in fewer than " +
+                   std::to_string(min_cameras) + " camera(s) in every frame)");
+  for (int i = 0; i < count; ++i) {
+    if (has_evidence[i]) continue;
+    int source = -1;
+    for (int d = 1; source < 0; ++d) {
+      if (i - d >= 0 && has_evidence[i - d]) source = i - d;
+      else if (i + d < count && has_evidence[i + d]) source = i + d;
+    }
+    FrameShapeInit& frame = (*frames)[i];
+    const FrameShapeInit& taken = (*frames)[source];
+    frame.hull_from_frame = taken.frame;
+    frame.carving = taken.carving;
+    frame.carving.frame = frame.frame;
+    frame.carving.warnings.clear();
+    frame.isosurface = taken.isosurface;
+    frame.hull = taken.hull;
+    const std::string warning =
+        "frame " + std::to_string(frame.frame) + ": no masks, no background, and motion evidence in fewer than " +
+        std::to_string(min_cameras) + " camera(s) (nothing moves): hull of frame " + std::to_string(taken.frame) +
+        " used";
+    spdlog::warn("{}", warning);
+    frame.carving.warnings.push_back(warning);
+  }
 }
 
 }  // namespace
@@ -47,23 +84,30 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   result.reference_frame = reference;
   result.frames.resize(count);
 
-  // Visual hull of every frame.
+  // Visual hull of every frame with evidence.
+  std::vector<bool> has_evidence(count, false);
   ProgressBegin(progress, "visual hull", count);
   for (int i = 0; i < count; ++i) {
     FrameShapeInit& frame = result.frames[i];
-    frame.frame = first + i;
+    frame.frame = frame.hull_from_frame = first + i;
     auto start = std::chrono::steady_clock::now();
-    frame.carving = vision::CarveFrame(dataset, frame.frame, options.silhouettes, options.carving);
-    frame.carve_seconds = SecondsSince(start);
-    start = std::chrono::steady_clock::now();
-    frame.hull = geometry::ExtractIsosurface(frame.carving.occupancy, options.isosurface,
-                                             &frame.isosurface,
-                                             "occupancy of frame " + vision::FrameName(frame.frame));
-    frame.isosurface_seconds = SecondsSince(start);
-    frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
+    const std::vector<vision::Silhouette> silhouettes =
+        vision::ComputeFrameEvidence(dataset, frame.frame, options.silhouettes);
+    has_evidence[i] = !vision::LacksEvidence(silhouettes, options.carving.min_cameras);
+    if (has_evidence[i]) {
+      frame.carving = vision::CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), options.carving,
+                                          frame.frame);
+      frame.carve_seconds = SecondsSince(start);
+      start = std::chrono::steady_clock::now();
+      frame.hull = geometry::ExtractIsosurface(frame.carving.occupancy, options.isosurface, &frame.isosurface,
+                                               "occupancy of frame " + vision::FrameName(frame.frame));
+      frame.isosurface_seconds = SecondsSince(start);
+      frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
+    }
     ProgressUpdate(progress, i + 1);
   }
   ProgressEnd(progress);
+  TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, options.carving.min_cameras, &result.frames);
 
   // Base mesh and hierarchy from the reference frame.
   auto start = std::chrono::steady_clock::now();

@@ -50,6 +50,11 @@ struct ShapeInitOptions {
 
 struct FrameShapeInit {
   int frame = 0;
+  // The frame whose evidence gave the hull: `frame` itself, or for a frame without any
+  // evidence (vision::LacksEvidence: no masks, no background, nothing moves) the nearest
+  // frame with evidence (the earlier one on a tie), whose hull and carving figures are
+  // taken, with a warning in carving.warnings.
+  int hull_from_frame = 0;
   vision::CarvingResult carving;             // figures; its occupancy volume is released
   geometry::IsosurfaceSummary isosurface;
   geometry::TriangleMesh hull;               // the visual-hull iso-surface H_f
@@ -69,8 +74,9 @@ struct ShapeInitResult {
 };
 
 // Runs the whole stage on `dataset`. Throws subflow::Error on bad input (see the
-// vision/geometry stages); warnings (cameras excluded, object touching the bounds) are
-// logged and kept in each frame's carving result.
+// vision/geometry stages), and when no frame has any evidence of the object; warnings
+// (cameras excluded, object touching the bounds, a frame without evidence) are logged
+// and kept in each frame's carving result.
 ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitOptions& options,
                                 Progress* progress = nullptr);
 

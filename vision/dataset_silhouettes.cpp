@@ -14,8 +14,17 @@
 
 namespace subflow::vision {
 
-std::vector<Silhouette> ComputeSilhouettes(const Dataset& dataset, int frame,
-                                           const SilhouetteOptions& options) {
+bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras) {
+  int non_empty = 0;
+  for (const Silhouette& silhouette : silhouettes) {
+    if (silhouette.source != EvidenceSource::kMotion) return false;
+    non_empty += !silhouette.empty;
+  }
+  return non_empty < min_cameras;
+}
+
+std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
+                                             const SilhouetteOptions& options) {
   options.Check();
   const std::string& source_name = dataset.directory();
   if (frame < 0 || frame >= dataset.frame_count())
@@ -76,13 +85,14 @@ std::vector<Silhouette> ComputeSilhouettes(const Dataset& dataset, int frame,
     }
   });
 
-  bool all_motion = true, all_empty = true;
-  for (int c = 0; c < camera_count; ++c) {
-    all_motion = all_motion && silhouettes[c].source == EvidenceSource::kMotion;
-    all_empty = all_empty && silhouettes[c].empty;
-  }
-  if (all_motion && all_empty)
-    ThrowError(source_name, "frame " + std::to_string(frame),
+  return silhouettes;
+}
+
+std::vector<Silhouette> ComputeSilhouettes(const Dataset& dataset, int frame,
+                                           const SilhouetteOptions& options) {
+  std::vector<Silhouette> silhouettes = ComputeFrameEvidence(dataset, frame, options);
+  if (LacksEvidence(silhouettes))
+    ThrowError(dataset.directory(), "frame " + std::to_string(frame),
                "no masks, no background, and no motion: cannot find the object");
   return silhouettes;
 }

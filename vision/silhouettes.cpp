@@ -95,6 +95,8 @@ void SilhouetteOptions::Check() const {
              "a value below 1 (negative = automatic)", background_threshold);
   CheckRange(background_min_threshold >= 0 && background_min_threshold < 1,
              "background_min_threshold", "a value in [0, 1)", background_min_threshold);
+  CheckRange(background_contour_fraction >= 0 && background_contour_fraction < 1,
+             "background_contour_fraction", "a value in [0, 1) (0 = off)", background_contour_fraction);
   CheckRange(motion_sigma >= 0 && motion_sigma <= 50, "motion_sigma", "a value in [0, 50] pixels",
              motion_sigma);
   CheckRange(motion_lambda > 0 && std::isfinite(motion_lambda), "motion_lambda",
@@ -199,6 +201,22 @@ double TriangleThreshold(const cv::Mat& values) {
   return lo + best_bin * bin_width;
 }
 
+namespace {
+
+cv::Mat Disk(int radius) {
+  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+}
+
+// Sets the mask and what follows from it: evidence, object_pixels, empty.
+void SetMask(const cv::Mat& mask, const SilhouetteOptions& options, Silhouette* silhouette) {
+  silhouette->mask = mask;
+  mask.convertTo(silhouette->evidence, CV_32F, 1.0 / 255.0);
+  silhouette->object_pixels = cv::countNonZero(mask);
+  silhouette->empty = silhouette->object_pixels < options.min_object_pixels;
+}
+
+}  // namespace
+
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
                              const SilhouetteOptions& options, int open_radius) {
   SUBFLOW_CHECK(measure.type() == CV_32FC1, "ThresholdAndClean expects CV_32FC1");
@@ -206,18 +224,38 @@ Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
   silhouette.measure = measure;
   silhouette.threshold = threshold;
   cv::Mat mask = measure > threshold;  // CV_8U 0 / 255
-  auto disk = [](int radius) {
-    return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
-  };
-  if (open_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_OPEN, disk(open_radius));
-  if (options.close_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, disk(options.close_radius));
+  if (open_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_OPEN, Disk(open_radius));
+  if (options.close_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, Disk(options.close_radius));
   if (options.min_region_pixels > 1) RemoveSmallRegions(&mask, options.min_region_pixels);
   if (options.fill_holes) FillHoles(&mask);
-  silhouette.mask = mask;
-  mask.convertTo(silhouette.evidence, CV_32F, 1.0 / 255.0);
-  silhouette.object_pixels = cv::countNonZero(mask);
-  silhouette.empty = silhouette.object_pixels < options.min_object_pixels;
+  SetMask(mask, options, &silhouette);
   return silhouette;
+}
+
+cv::Mat HalfContrastContour(const cv::Mat& measure, const cv::Mat& mask, double fraction) {
+  SUBFLOW_CHECK(measure.type() == CV_32FC1 && mask.type() == CV_8UC1 && measure.size() == mask.size(),
+                "HalfContrastContour expects a CV_32FC1 measure and a CV_8UC1 mask of one size");
+  constexpr int kBand = 2, kInterior = 3, kWindow = 5;  // pixels
+  cv::Mat band, interior;
+  cv::erode(mask, band, Disk(kBand), cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+  band = mask & ~band;
+  cv::erode(mask, interior, Disk(kInterior), cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
+  cv::Mat weight, weighted_sum, weight_sum;
+  interior.convertTo(weight, CV_32F, 1.0 / 255.0);
+  const cv::Size window(2 * kWindow + 1, 2 * kWindow + 1);
+  cv::boxFilter(measure.mul(weight), weighted_sum, CV_32F, window, cv::Point(-1, -1), false);
+  cv::boxFilter(weight, weight_sum, CV_32F, window, cv::Point(-1, -1), false);
+  cv::Mat refined = mask.clone();
+  for (int y = 0; y < mask.rows; ++y) {
+    const uint8_t* band_row = band.ptr<uint8_t>(y);
+    const float* value = measure.ptr<float>(y);
+    const float* sum = weighted_sum.ptr<float>(y);
+    const float* count = weight_sum.ptr<float>(y);
+    uint8_t* row = refined.ptr<uint8_t>(y);
+    for (int x = 0; x < mask.cols; ++x)
+      if (band_row[x] && count[x] > 0 && value[x] < fraction * sum[x] / count[x]) row[x] = 0;
+  }
+  return refined;
 }
 
 Silhouette SilhouetteFromMask(const cv::Mat& mask, const SilhouetteOptions& options) {
@@ -262,6 +300,9 @@ Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& backgro
                                               options.background_min_threshold);
   Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius);
   silhouette.source = EvidenceSource::kBackground;
+  if (options.background_contour_fraction > 0)
+    SetMask(HalfContrastContour(measure, silhouette.mask, options.background_contour_fraction), options,
+            &silhouette);
   return silhouette;
 }
 

@@ -249,9 +249,9 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
     ThrowError(where, "cameras", "only " + std::to_string(used.size()) +
                                      " camera(s) usable, min_cameras = " + std::to_string(options.min_cameras));
 
-  bool all_masks = true;
-  for (const CarvingCamera& c : used) all_masks = all_masks && silhouettes[c.index].source == EvidenceSource::kMask;
-  result.max_misses = options.max_misses >= 0 ? options.max_misses : (all_masks ? 0 : 1);
+  bool any_motion = false;
+  for (const CarvingCamera& c : used) any_motion = any_motion || silhouettes[c.index].source == EvidenceSource::kMotion;
+  result.max_misses = options.max_misses >= 0 ? options.max_misses : (any_motion ? 1 : 0);
   result.resolution = ChooseResolution(cameras, bounds, options);
   result.occupancy = MakeVoxelGrid(bounds, result.resolution);
   ScalarVolume& occupancy = result.occupancy;

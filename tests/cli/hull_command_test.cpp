@@ -66,11 +66,12 @@ TEST(HullCommand, ReportRecordsEverySilhouetteAndCarvingOptionAndTheValuesUsed) 
   const nlohmann::json& silhouettes = options.at("silhouettes");
   for (const char* field :
        {"source", "background_blur_sigma", "background_threshold", "background_method",
-        "background_open_radius", "background_min_threshold", "motion_sigma", "motion_lambda",
+        "background_open_radius", "background_min_threshold", "background_contour_fraction",
+        "motion_sigma", "motion_lambda",
         "motion_window", "motion_threshold", "motion_method", "motion_min_threshold",
         "close_radius", "fill_holes", "min_region_pixels", "min_object_pixels"})
     EXPECT_TRUE(silhouettes.contains(field)) << "silhouettes." << field;
-  EXPECT_EQ(silhouettes.size(), 16u) << silhouettes.dump();
+  EXPECT_EQ(silhouettes.size(), 17u) << silhouettes.dump();
   EXPECT_EQ(silhouettes.at("background_threshold").get<double>(), 0.07);
   EXPECT_EQ(silhouettes.at("background_method").get<std::string>(), "triangle");
   EXPECT_EQ(silhouettes.at("motion_method").get<std::string>(), "otsu");
@@ -85,6 +86,7 @@ TEST(HullCommand, ReportRecordsEverySilhouetteAndCarvingOptionAndTheValuesUsed) 
   EXPECT_EQ(carving.at("min_cameras").get<int>(), 3);
   EXPECT_EQ(carving.at("max_misses").get<int>(), -1);  // automatic, as given
   EXPECT_EQ(carving.at("footprint_margin").get<double>(), 0.5);
+  EXPECT_EQ(carving.at("evidence_threshold").get<double>(), 0.1);
 
   // Per frame, the values the automatic options took: masks everywhere → max_misses 0,
   // threshold 0.5 per camera.
@@ -92,6 +94,7 @@ TEST(HullCommand, ReportRecordsEverySilhouetteAndCarvingOptionAndTheValuesUsed) 
   ASSERT_EQ(frames.size(), 3u);
   for (const nlohmann::json& frame : frames) {
     EXPECT_EQ(frame.at("max_misses").get<int>(), 0);
+    EXPECT_EQ(frame.at("hull_from_frame").get<int>(), frame.at("frame").get<int>());
     EXPECT_GT(frame.at("voxel_resolution").get<int>(), 8);
     EXPECT_GE(frame.at("carved_voxels").get<long>(), frame.at("occupied_voxels").get<long>() / 2);
     EXPECT_EQ(frame.at("border_voxels").size(), 6u);
@@ -100,6 +103,40 @@ TEST(HullCommand, ReportRecordsEverySilhouetteAndCarvingOptionAndTheValuesUsed) 
       EXPECT_EQ(camera.at("source").get<std::string>(), "mask");
       EXPECT_EQ(camera.at("threshold").get<double>(), 0.5);
     }
+  }
+}
+
+// The carving options given on the command line reach the carving and report.json.
+TEST(HullCommand, CarvingFlagsAreUsedAndRecorded) {
+  const fs::path out = Scratch().FreshPath("flags");
+  const test::CommandResult run = test::RunSubflow(
+      HullArguments(out) + " --frames 1 --max-misses 1 --evidence-threshold 0.25 --footprint-margin 1.5"
+                           " --motion-window 1 --evidence background",
+      Scratch().path());
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  const nlohmann::json report = nlohmann::json::parse(test::ReadTextFile(out / "report.json"));
+  const nlohmann::json& options = report.at("options").at("shape_init");
+  EXPECT_EQ(options.at("carving").at("max_misses").get<int>(), 1);
+  EXPECT_EQ(options.at("carving").at("evidence_threshold").get<double>(), 0.25);
+  EXPECT_EQ(options.at("carving").at("footprint_margin").get<double>(), 1.5);
+  EXPECT_EQ(options.at("silhouettes").at("motion_window").get<int>(), 1);
+  const nlohmann::json& frame = report.at("shape_init").at("frames").at(0);
+  EXPECT_EQ(frame.at("max_misses").get<int>(), 1);  // the value used
+  EXPECT_EQ(frame.at("cameras").at(0).at("source").get<std::string>(), "background");
+  EXPECT_EQ(frame.at("cameras").at(0).at("threshold").get<double>(), 0.07);
+}
+
+// Bad values of the carving flags: a one-line error naming the flag and the range, exit ≠ 0.
+TEST(HullCommand, BadCarvingFlagValuesAreRejectedNamingTheFlag) {
+  for (const std::string flag : {"--max-misses -2", "--min-cameras 0", "--evidence-threshold 0",
+                                 "--evidence-threshold 1.5", "--footprint-margin -1", "--motion-window -1",
+                                 "--lambda 0", "--max-misses two"}) {
+    const fs::path out = Scratch().FreshPath("bad");
+    const test::CommandResult run = test::RunSubflow(HullArguments(out) + " " + flag, Scratch().path());
+    EXPECT_NE(run.exit_code, 0) << flag;
+    const std::string name = flag.substr(0, flag.find(' '));
+    EXPECT_NE(run.err.find(name), std::string::npos) << flag << ": " << run.err;
+    EXPECT_FALSE(fs::exists(out / "report.json")) << flag;
   }
 }
 

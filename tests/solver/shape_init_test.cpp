@@ -73,16 +73,19 @@ SphereFit TrueSphere(const vision::Dataset& dataset, int frame) {
   return sphere;
 }
 
-// Every ground-truth vertex inside the hull; returns the Hausdorff distance between the
-// hull and the true sphere (hull vertices to the analytic sphere, true vertices to the hull).
-double ExpectContainsTruthAndHausdorff(const vision::Dataset& dataset, const FrameShapeInit& frame) {
+// Every ground-truth vertex inside the hull (all but `max_outside_fraction` of them);
+// returns the Hausdorff distance between the hull and the true sphere (hull vertices to
+// the analytic sphere, true vertices to the hull).
+double ExpectContainsTruthAndHausdorff(const vision::Dataset& dataset, const FrameShapeInit& frame,
+                                       double max_outside_fraction = 0.0) {
   const geometry::TriangleMesh truth = geometry::ReadMesh(dataset.GroundTruthMeshPath(frame.frame));
   const SphereFit sphere = TrueSphere(dataset, frame.frame);
   const geometry::ClosestPointTree hull(frame.hull, "hull");
   int outside = 0;
   for (Eigen::Index i = 0; i < truth.V.rows(); ++i)
     outside += hull.Side(truth.V.row(i).transpose()) == geometry::PointSide::kOutside;
-  EXPECT_EQ(outside, 0) << "of " << truth.V.rows() << " true vertices outside the hull of frame " << frame.frame;
+  EXPECT_LE(outside, max_outside_fraction * truth.V.rows())
+      << "of " << truth.V.rows() << " true vertices outside the hull of frame " << frame.frame;
   double hausdorff = hull.Distances(truth.V).maxCoeff();
   for (Eigen::Index i = 0; i < frame.hull.V.rows(); ++i)
     hausdorff = std::max(hausdorff, std::abs((frame.hull.V.row(i).transpose() - sphere.centre).norm() - sphere.radius));
@@ -108,6 +111,41 @@ TEST(ShapeInit, HullOfAConvexObjectContainsItAndLiesWithinThreeVoxels) {
                 frame.frame, frame.carving.resolution, 1e3 * voxel, 1e3 * hausdorff, hausdorff / voxel,
                 frame.carving.mean_silhouette_iou);
     EXPECT_LE(hausdorff, 3.0 * voxel) << "frame " << frame.frame;
+  }
+}
+
+// Mean distance of the hull's vertices from the true sphere (outside positive).
+double MeanExcess(const vision::Dataset& dataset, const FrameShapeInit& frame) {
+  const SphereFit sphere = TrueSphere(dataset, frame.frame);
+  return ((frame.hull.V.rowwise() - sphere.centre.transpose()).rowwise().norm().array() - sphere.radius).mean();
+}
+
+// Without masks, the background difference gives a hull as close as the masks' (the
+// silhouettes match the masks to ~½ pixel, and the strict hull, max_misses = 0, is carved
+// from them): same claim (contains the sphere, Hausdorff ≤ 3 voxels), and a mean excess
+// over the sphere within 1.5 × the masks' plus a quarter voxel. The silhouettes' contours
+// are estimated, not given: a few true vertices (≤ 0.5 %) may fall just outside.
+TEST(ShapeInit, HullFromBackgroundDifferenceIsAsCloseAsTheHullFromMasks) {
+  const fs::path directory = Scratch().FreshPath("background_only");
+  vision::WriteSyntheticDataset(directory.string(), SphereOptions("dome", 10, 160, 120, 2));
+  const vision::Dataset with_masks(directory.string());
+  const ShapeInitResult from_masks = InitializeShape(with_masks, QuickOptions());
+  fs::remove_all(directory / "masks");
+  const vision::Dataset dataset(directory.string());
+  const ShapeInitResult result = InitializeShape(dataset, QuickOptions());
+  ASSERT_EQ(result.frames.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    const FrameShapeInit& frame = result.frames[i];
+    ASSERT_EQ(frame.carving.cameras.front().source, vision::EvidenceSource::kBackground);
+    EXPECT_EQ(frame.carving.max_misses, 0);
+    const double voxel = VoxelSize(dataset, frame);
+    const double hausdorff = ExpectContainsTruthAndHausdorff(dataset, frame, 0.005);
+    const double excess = MeanExcess(dataset, frame), mask_excess = MeanExcess(with_masks, from_masks.frames[i]);
+    std::printf("[ figures ] frame %d: background hull: Hausdorff %.2f voxels, mean excess %.3f voxels (masks: %.3f), "
+                "mean silhouette IoU %.4f\n",
+                frame.frame, hausdorff / voxel, excess / voxel, mask_excess / voxel, frame.carving.mean_silhouette_iou);
+    EXPECT_LE(hausdorff, 3.0 * voxel) << "frame " << frame.frame;
+    EXPECT_LE(excess, 1.5 * mask_excess + 0.25 * voxel) << "frame " << frame.frame;
   }
 }
 
@@ -210,6 +248,38 @@ TEST(ShapeInitBadInput, ObjectLeavingTheBoundsIsReportedAndTheRestIsComputed) {
     EXPECT_LE(frame.hull.V.col(0).maxCoeff(), cut + VoxelSize(dataset, frame));
   }
   EXPECT_GT(result.base_mesh.face_count(), 0);
+}
+
+// Frames 0 and 1 show the same images as frame 2 (the object waits, then moves), without
+// masks or background: with a motion window of 0, frames 0 and 1 see no motion at all.
+// They get a warning naming them and the hull of frame 2, the nearest frame with
+// evidence; frames 2..4 are carved from their own motion evidence.
+TEST(ShapeInitBadInput, FrameWithoutMasksAndMotionTakesTheHullOfItsNearestFrameWithEvidence) {
+  const fs::path directory = Scratch().FreshPath("waits");
+  vision::WriteSyntheticDataset(directory.string(), SphereOptions("ring", 5, 96, 72, 5));
+  fs::remove_all(directory / "masks");
+  fs::remove_all(directory / "background");
+  for (const auto& camera : fs::directory_iterator(directory / "images"))
+    for (const char* frame : {"000000.png", "000001.png"})
+      fs::copy_file(camera.path() / "000002.png", camera.path() / frame, fs::copy_options::overwrite_existing);
+  const vision::Dataset dataset(directory.string());
+  ShapeInitOptions options = QuickOptions();
+  options.silhouettes.motion_window = 0;
+  options.reference_frame = 3;
+  const ShapeInitResult result = InitializeShape(dataset, options);
+  ASSERT_EQ(result.frames.size(), 5u);
+  for (const FrameShapeInit& frame : result.frames) {
+    const bool waits = frame.frame < 2;
+    EXPECT_EQ(frame.hull_from_frame, waits ? 2 : frame.frame);
+    EXPECT_EQ(AnyContains(frame.carving.warnings, "frame " + std::to_string(frame.frame) +
+                                                      ": no masks, no background, and motion evidence in fewer"),
+              waits)
+        << "frame " << frame.frame;
+    EXPECT_GT(frame.hull.face_count(), 100) << "frame " << frame.frame;
+    ASSERT_FALSE(frame.control.empty());
+  }
+  EXPECT_EQ(result.frames[0].hull.V, result.frames[2].hull.V);
+  EXPECT_EQ(result.frames[1].hull.V, result.frames[2].hull.V);
 }
 
 TEST(ShapeInitBadInput, NoMasksNoBackgroundAndNoMotionIsAnErrorThatSaysSo) {

@@ -126,6 +126,39 @@ TEST(Silhouettes, BackgroundDifferenceWithAutomaticThresholdRecoversDrawnDisk) {
   EXPECT_THROW(BackgroundDifference(image8, gray_background), Error);
 }
 
+// An anti-aliased disk (pixel = its coverage, from an 8× supersampled drawing) of level 0.6
+// on a dark background of 0.05: the exact mask is coverage > ½. The automatic threshold
+// sits at the foot of the noise, where a pixel with a few per cent of coverage is object;
+// moving the contour to half contrast (HalfContrastContour at ½) recovers the mask to
+// within a few pixels, and the default silhouette is narrower than the unrefined one.
+TEST(Silhouettes, HalfContrastContourRecoversTheHalfCoverageMask) {
+  const int width = 120, height = 90, scale = 8;
+  cv::Mat fine = cv::Mat::zeros(height * scale, width * scale, CV_32F);
+  cv::circle(fine, cv::Point(60 * scale + 3, 45 * scale + 5), 30 * scale + 3, cv::Scalar(1), cv::FILLED);
+  cv::Mat coverage;
+  cv::resize(fine, coverage, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  const cv::Mat truth = coverage > 0.5f;
+  cv::Mat image8, background8;
+  cv::Mat(0.05f + 0.55f * coverage).convertTo(image8, CV_8U, 255.0);
+  cv::Mat(cv::Mat::ones(height, width, CV_32F) * 0.05f).convertTo(background8, CV_8U, 255.0);
+
+  SilhouetteOptions unrefined;
+  unrefined.background_contour_fraction = 0;
+  const Silhouette wide = SilhouetteFromBackground(image8, background8, unrefined);
+  const cv::Mat half = HalfContrastContour(wide.measure, wide.mask, 0.5);
+  const Silhouette refined = SilhouetteFromBackground(image8, background8);
+  const int wrong_half = cv::countNonZero(half ^ truth);
+  const int wrong_wide = cv::countNonZero(wide.mask ^ truth);
+  const int wrong_default = cv::countNonZero(refined.mask ^ truth);
+  std::printf("[ figures ] pixels differing from the half-coverage mask (perimeter ≈ 190 px): unrefined %d, "
+              "half contrast %d, default (%.2f) %d\n",
+              wrong_wide, wrong_half, SilhouetteOptions().background_contour_fraction, wrong_default);
+  EXPECT_GT(wrong_wide, 100);  // about one ring of pixels too wide
+  EXPECT_LT(wrong_half, 20);
+  EXPECT_LT(wrong_default, wrong_wide / 2);
+  EXPECT_EQ(cv::countNonZero(half & ~wide.mask), 0);  // only removes pixels
+}
+
 // The right half's texture moves one pixel per frame to the right; the left half is static.
 TEST(Silhouettes, MotionEvidenceIsPositiveWhereTextureMovesAndZeroElsewhere) {
   const int width = 120, height = 80, half = width / 2;
