@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 
 #include "geometry/error.h"
 #include "geometry/local_frames.h"
@@ -37,9 +38,9 @@ inline void GeneralTangents(const SynthesisPlan& plan, int row, const double* co
 //
 // Per block of vertices, two phases:
 //  1. per vertex, gather its few source points and form the predicted point p and the
-//     tangents (t1, t2) of synthesis_plan.h (rotated), the three coordinates of a point in
-//     one vector value (x, y, z, ·) — one AVX register, or two SSE2 ones — stored
-//     structure-of-arrays;
+//     tangents (t1, t2) of synthesis_plan.h (rotated), stored structure-of-arrays; the AVX2
+//     kernels hold the three coordinates of a point in one register (x, y, z, ·), the
+//     baseline ones go through the coordinates one at a time;
 //  2. element-wise over the block, in loops the compiler vectorizes across vertices: the
 //     frame (as FramesOfBlock: degenerate lanes selected, not branched to) and the output
 //     row p + d_n n + d_r r + d_q q.
@@ -89,14 +90,43 @@ SUBFLOW_KERNEL void StoreColumn(double (*soa)[kSynthesisBlock], int j, Point4 va
   soa[2][j] = value[2];
 }
 
-// The tangents t1 = cos φ a − sin φ b, t2 = cos φ b + sin φ a of rotation `rotation` of the
-// plan's table (a, b themselves for kGeneral) into column j of block->a, block->b.
-SUBFLOW_KERNEL void StoreRotated(const double* rotations, std::uint8_t rotation, Point4 a,
-                                 Point4 b, int j, SynthesisBlock* block) {
+// The phase-1 formulas run on a type T of coordinates: Point4 (the three at once, the AVX2
+// kernels) or double (one coordinate k at a time, the baseline kernels: with SSE2 a Point4
+// is two registers, and ten of them no longer fit in the sixteen).
+template <typename T>
+constexpr int kCoordinatePasses = std::is_same_v<T, double> ? 3 : 1;
+
+template <typename T>
+SUBFLOW_KERNEL T Load(const double* points, int index, int k) {
+  if constexpr (std::is_same_v<T, double>)
+    return points[3 * static_cast<Eigen::Index>(index) + k];
+  else
+    return LoadPoint(points, index);
+}
+
+template <typename T>
+SUBFLOW_KERNEL void Store(double (*soa)[kSynthesisBlock], int j, int k, T value) {
+  if constexpr (std::is_same_v<T, double>)
+    soa[k][j] = value;
+  else
+    StoreColumn(soa, j, value);
+}
+
+// The tangents t1 = cos φ a − sin φ b, t2 = cos φ b + sin φ a (coordinate k, or all) into
+// column j of block->a, block->b.
+template <typename T>
+SUBFLOW_KERNEL void StoreRotated(double cs, double sn, T a, T b, int j, int k,
+                                 SynthesisBlock* block) {
+  Store(block->a, j, k, cs * a - sn * b);
+  Store(block->b, j, k, cs * b + sn * a);
+}
+
+// (cos φ, sin φ) of rotation code `rotation` of the plan's table; (1, 0) for kGeneral.
+SUBFLOW_KERNEL void Rotation(const double* rotations, std::uint8_t rotation, double* cs,
+                             double* sn) {
   const int index = rotation == SynthesisPlan::kGeneral ? 0 : rotation;
-  const double cs = rotations[2 * index], sn = rotations[2 * index + 1];
-  StoreColumn(block->a, j, cs * a - sn * b);
-  StoreColumn(block->b, j, cs * b + sn * a);
+  *cs = rotations[2 * index];
+  *sn = rotations[2 * index + 1];
 }
 
 // a · b + c, fused (one rounding) in the FMA kernels.
@@ -125,15 +155,16 @@ SUBFLOW_KERNEL void FinishBlock(SynthesisBlock* block, int size, const double* _
     const double a_2 = MulAdd<kFma>(t1[0], t1[0], MulAdd<kFma>(t1[1], t1[1], t1[2] * t1[2]));
     const double b_2 = MulAdd<kFma>(t2[0], t2[0], MulAdd<kFma>(t2[1], t2[1], t2[2] * t2[2]));
     const bool regular = cross2 > kDegenerateSine * kDegenerateSine * a_2 * b_2;  // false on NaN
-    block->n[0][j] = regular ? x : 0.0;  // c
-    block->n[1][j] = regular ? y : 0.0;
-    block->n[2][j] = regular ? z : 1.0;
-    block->a[0][j] = regular ? t1[0] : 1.0;  // t1, or e_x
-    block->a[1][j] = regular ? t1[1] : 0.0;
-    block->a[2][j] = regular ? t1[2] : 0.0;
-    const double cross_length = std::sqrt(cross2), a_length = std::sqrt(a_2);
-    block->length[0][j] = regular ? cross_length : 1.0;
-    block->length[1][j] = regular ? a_length : 1.0;
+    const double c[3] = {regular ? x : 0.0, regular ? y : 0.0, regular ? z : 1.0};  // or e_z
+    const double t[3] = {regular ? t1[0] : 1.0, regular ? t1[1] : 0.0,
+                         regular ? t1[2] : 0.0};  // or e_x
+    for (int k = 0; k < 3; ++k) {
+      block->n[k][j] = c[k];
+      block->a[k][j] = t[k];
+    }
+    // The lengths of the selected vectors: |c| and |t1|, or exactly 1 on a degenerate lane.
+    block->length[0][j] = std::sqrt(MulAdd<kFma>(c[0], c[0], MulAdd<kFma>(c[1], c[1], c[2] * c[2])));
+    block->length[1][j] = std::sqrt(MulAdd<kFma>(t[0], t[0], MulAdd<kFma>(t[1], t[1], t[2] * t[2])));
   }
   for (int j = 0; j < size; ++j) {
     const double cross_length = block->length[0][j];
@@ -158,6 +189,7 @@ SUBFLOW_KERNEL void FinishBlock(SynthesisBlock* block, int size, const double* _
 // Phase 1 of the even vertices v ∈ [first, first + size): p by the refinement row (Apply's
 // sums, in its order; also stored to even_points for the odd pass), tangents by level
 // level − 1's stencil at v on the coarse points.
+template <typename T>
 SUBFLOW_KERNEL void GatherEvenBlock(const SynthesisStep& step, int first, int size,
                                     SynthesisBlock* block) {
   const PointStencil& refinement = *step.refinement;
@@ -173,79 +205,93 @@ SUBFLOW_KERNEL void GatherEvenBlock(const SynthesisStep& step, int first, int si
     const int* column = columns + offsets[v];
     const int count = offsets[v + 1] - offsets[v];
     const std::uint8_t rotation = plan.even_rotation[v];
-    Point4 s, a, b;
+    double cs, sn;
+    Rotation(plan.rotations.data(), rotation, &cs, &sn);
+    double* even = step.even_points + 3 * static_cast<Eigen::Index>(v);
     if (count == 7 && rotation != SynthesisPlan::kGeneral) {
       // Interior, valence 6: the ring is the row's columns 1..6.
-      const Point4 x0 = LoadPoint(c, column[0]), x1 = LoadPoint(c, column[1]),
-                   x2 = LoadPoint(c, column[2]), x3 = LoadPoint(c, column[3]),
-                   x4 = LoadPoint(c, column[4]), x5 = LoadPoint(c, column[5]),
-                   x6 = LoadPoint(c, column[6]);
-      s = w[0] * x0;
-      s += w[1] * x1;
-      s += w[2] * x2;
-      s += w[3] * x3;
-      s += w[4] * x4;
-      s += w[5] * x5;
-      s += w[6] * x6;
-      const double h = 0.8660254037844386;  // √3/2
-      a = (x1 - x4) + 0.5 * ((x2 + x6) - (x3 + x5));
-      b = h * ((x2 + x3) - (x5 + x6));
+      for (int k = 0; k < kCoordinatePasses<T>; ++k) {
+        const T x0 = Load<T>(c, column[0], k), x1 = Load<T>(c, column[1], k),
+                x2 = Load<T>(c, column[2], k), x3 = Load<T>(c, column[3], k),
+                x4 = Load<T>(c, column[4], k), x5 = Load<T>(c, column[5], k),
+                x6 = Load<T>(c, column[6], k);
+        T s = w[0] * x0;
+        s += w[1] * x1;
+        s += w[2] * x2;
+        s += w[3] * x3;
+        s += w[4] * x4;
+        s += w[5] * x5;
+        s += w[6] * x6;
+        const double h = 0.8660254037844386;  // √3/2
+        const T a = (x1 - x4) + 0.5 * ((x2 + x6) - (x3 + x5));
+        const T b = h * ((x2 + x3) - (x5 + x6));
+        Store(block->p, j, k, s);
+        StoreRotated(cs, sn, a, b, j, k, block);
+        if constexpr (std::is_same_v<T, double>)
+          even[k] = s;
+        else
+          even[0] = s[0], even[1] = s[1], even[2] = s[2];
+      }
     } else {
-      s = Point4{0.0, 0.0, 0.0, 0.0};
+      Point4 s{0.0, 0.0, 0.0, 0.0};
       for (int i = 0; i < count; ++i) s += w[i] * LoadPoint(c, column[i]);
       double t1[3], t2[3];
       if (rotation == SynthesisPlan::kGeneral)
         GeneralTangents(plan, plan.even_general_row[v], c, t1, t2);
       else
         TangentsAt(*step.coarse_tangents, step.regular_offset, c, v, t1, t2);
-      a = Point4{t1[0], t1[1], t1[2], 0.0};
-      b = Point4{t2[0], t2[1], t2[2], 0.0};
+      for (int k = 0; k < 3; ++k) {
+        even[k] = s[k];
+        block->p[k][j] = s[k];
+        StoreRotated(cs, sn, t1[k], t2[k], j, k, block);
+      }
     }
-    double* even = step.even_points + 3 * static_cast<Eigen::Index>(v);
-    even[0] = s[0], even[1] = s[1], even[2] = s[2];
-    StoreColumn(block->p, j, s);
-    StoreRotated(plan.rotations.data(), rotation, a, b, j, block);
   }
 }
 
 // Phase 1 of the odd vertices nc + e, e ∈ [first, first + size): p = 3/8 (a + b) +
 // 1/8 (P + Q) (Apply's order), tangents by the closed form of synthesis_plan.h on the
 // coarse and even predicted points; general rows otherwise.
+template <typename T>
 SUBFLOW_KERNEL void GatherOddBlock(const SynthesisStep& step, int first, int size,
                                    SynthesisBlock* block) {
   const SynthesisPlan& plan = *step.plan;
   const PointStencil& refinement = *step.refinement;
   const double* c = step.coarse;
   const double* even = step.even_points;
-  const double* rotations = plan.rotations.data();
   for (int j = 0; j < size; ++j) {
     const int e = first + j;
     const int* col = plan.odd_columns.data() + 8 * static_cast<Eigen::Index>(e);
     const std::uint8_t rotation = plan.odd_rotation[e];
-    Point4 p, a, b;
+    double cs, sn;
+    Rotation(plan.rotations.data(), rotation, &cs, &sn);
     if (rotation == SynthesisPlan::kGeneral) {
       const int m = plan.coarse_vertex_count + e;
       const double* w = refinement.weights() + refinement.weight_offsets()[m];
-      p = Point4{0.0, 0.0, 0.0, 0.0};
+      Point4 p{0.0, 0.0, 0.0, 0.0};
       for (int i = refinement.offsets()[m]; i < refinement.offsets()[m + 1]; ++i, ++w)
         p += *w * LoadPoint(c, refinement.columns()[i]);
       double t1[3], t2[3];
       GeneralTangents(plan, col[0], c, t1, t2);
-      a = Point4{t1[0], t1[1], t1[2], 0.0};
-      b = Point4{t2[0], t2[1], t2[2], 0.0};
-    } else {
-      const Point4 pa = LoadPoint(c, col[0]), pb = LoadPoint(c, col[1]),
-                   pp = LoadPoint(c, col[2]), pq = LoadPoint(c, col[3]),
-                   x1 = LoadPoint(c, col[4]), x2 = LoadPoint(c, col[5]),
-                   x3 = LoadPoint(c, col[6]), x4 = LoadPoint(c, col[7]),
-                   ea = LoadPoint(even, col[0]), eb = LoadPoint(even, col[1]);
-      p = ((0.375 * pa + 0.375 * pb) + 0.125 * pp) + 0.125 * pq;
-      a = (ea - eb) + 0.25 * (pa - pb) + 0.0625 * ((x1 + x4) - (x2 + x3));
-      const double h = 0.8660254037844386;  // √3/2
-      b = h * (0.75 * (pq - pp) + 0.125 * ((x1 + x2) - (x3 + x4)));
+      for (int k = 0; k < 3; ++k) {
+        block->p[k][j] = p[k];
+        StoreRotated(cs, sn, t1[k], t2[k], j, k, block);
+      }
+      continue;
     }
-    StoreColumn(block->p, j, p);
-    StoreRotated(rotations, rotation, a, b, j, block);
+    for (int k = 0; k < kCoordinatePasses<T>; ++k) {
+      const T pa = Load<T>(c, col[0], k), pb = Load<T>(c, col[1], k),
+              pp = Load<T>(c, col[2], k), pq = Load<T>(c, col[3], k),
+              x1 = Load<T>(c, col[4], k), x2 = Load<T>(c, col[5], k),
+              x3 = Load<T>(c, col[6], k), x4 = Load<T>(c, col[7], k),
+              ea = Load<T>(even, col[0], k), eb = Load<T>(even, col[1], k);
+      const T p = ((0.375 * pa + 0.375 * pb) + 0.125 * pp) + 0.125 * pq;
+      const T a = (ea - eb) + 0.25 * (pa - pb) + 0.0625 * ((x1 + x4) - (x2 + x3));
+      const double h = 0.8660254037844386;  // √3/2
+      const T b = h * (0.75 * (pq - pp) + 0.125 * ((x1 + x2) - (x3 + x4)));
+      Store(block->p, j, k, p);
+      StoreRotated(cs, sn, a, b, j, k, block);
+    }
   }
 }
 
@@ -255,7 +301,7 @@ SUBFLOW_KERNEL void EvenVertices(const SynthesisStep& step, int begin, int end) 
   SynthesisBlock block;
   for (int first = begin; first < end; first += kSynthesisBlock) {
     const int size = std::min(kSynthesisBlock, end - first);
-    GatherEvenBlock(step, first, size, &block);
+    GatherEvenBlock<std::conditional_t<kFma, Point4, double>>(step, first, size, &block);
     FinishBlock<kFma>(&block, size, step.details + 3 * static_cast<Eigen::Index>(first),
                       step.out + 3 * static_cast<Eigen::Index>(first));
   }
@@ -267,7 +313,7 @@ SUBFLOW_KERNEL void OddVertices(const SynthesisStep& step, int begin, int end) {
   const Eigen::Index nc = step.plan->coarse_vertex_count;
   for (int first = begin; first < end; first += kSynthesisBlock) {
     const int size = std::min(kSynthesisBlock, end - first);
-    GatherOddBlock(step, first, size, &block);
+    GatherOddBlock<std::conditional_t<kFma, Point4, double>>(step, first, size, &block);
     FinishBlock<kFma>(&block, size, step.details + 3 * (nc + first),
                       step.out + 3 * (nc + first));
   }
