@@ -411,9 +411,8 @@ struct BlobFigures {
 // Carves frame 0 of ../shared/data/blob (10 cameras, 320 × 240) from one source of
 // evidence at 64 voxels along the longest axis (4.2 mm ≈ 3 px: modest, for test time) and
 // measures it against the ground-truth mesh and the masks.
-BlobFigures CarveBlob(EvidenceSource source) {
+BlobFigures CarveBlob(EvidenceSource source, SilhouetteOptions silhouette_options = {}) {
   const Dataset dataset(SUBFLOW_SHARED_DIR "/data/blob");
-  SilhouetteOptions silhouette_options;
   silhouette_options.source = source;
   VoxelCarvingOptions carving_options;
   carving_options.resolution = 64;
@@ -481,18 +480,35 @@ TEST(VoxelCarvingBlob, FromBackgroundDifferenceContainsTheObject) {
   EXPECT_GT(figures.mask_iou, 0.88);
 }
 
-// Motion evidence (eq. 23, window of frames 0..2 at the first frame): the silhouettes
-// spread ~2 px beyond the contour (smoothing, ~1.4 px of motion over the central
-// difference) and miss bites where weak texture moves along the contour; max_misses = 1
-// tolerates a bite in one camera per voxel, so a few vertices may fall outside.
-TEST(VoxelCarvingBlob, FromMotionEvidenceNearlyContainsTheObject) {
-  const BlobFigures figures = CarveBlob(EvidenceSource::kMotion);
+// Motion evidence (eq. 23) accumulated over a window of frames 0..2 at the first frame:
+// the silhouettes spread ~2 px beyond the contour (smoothing, ~1.4 px of motion over the
+// central difference) and miss bites where weak texture moves along the contour;
+// max_misses = 1 tolerates a bite in one camera per voxel, so a few vertices may fall outside.
+SilhouetteOptions MotionWindow(int half_width) {
+  SilhouetteOptions options;
+  options.motion_window = half_width;
+  return options;
+}
+
+TEST(VoxelCarvingBlob, FromMotionEvidenceOverAWindowNearlyContainsTheObject) {
+  const BlobFigures figures = CarveBlob(EvidenceSource::kMotion, MotionWindow(2));
   EXPECT_EQ(figures.result.max_misses, 1);
   EXPECT_GE(figures.in_voxel_fraction, 0.95);
   EXPECT_GE(figures.inside_fraction, 0.97);
   EXPECT_GT(figures.volume_ratio, 1.0);
   EXPECT_LT(figures.volume_ratio, 1.3);
   EXPECT_GT(figures.mask_iou, 0.85);
+}
+
+// Without the window (the default), the silhouettes are not the union of the positions
+// over five frames: the hull is tighter (closer to the masks, smaller volume).
+TEST(VoxelCarvingBlob, FromMotionEvidenceOfOneFrameIsTighterThanOverAWindow) {
+  const BlobFigures window = CarveBlob(EvidenceSource::kMotion, MotionWindow(2));
+  const BlobFigures single = CarveBlob(EvidenceSource::kMotion, MotionWindow(0));
+  EXPECT_GT(single.mask_iou, window.mask_iou);
+  EXPECT_LT(single.volume_ratio, window.volume_ratio);
+  EXPECT_GT(single.volume_ratio, 1.0);
+  EXPECT_GE(single.in_voxel_fraction, 0.95);
 }
 
 // ---- morphology and components ----
