@@ -63,6 +63,9 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
   sub->add_option("--refine-to", o->finest_level,
                   "Finest level refined by stereo (-1 = one below the finest level)")->capture_default_str();
   sub->add_option("--window", o->window, "Frames refined jointly")->capture_default_str();
+  sub->add_option("--window-overlap", o->window_overlap,
+                  "Frames a window shares with the next one (solved again there; < --window)")
+      ->capture_default_str();
   sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
   sub->add_option("--iterations", o->max_iterations, "Ceres iterations per round")->capture_default_str();
   sub->add_option("--linear-solver", o->linear_solver,

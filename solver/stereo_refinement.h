@@ -74,7 +74,9 @@ struct StereoRefinementOptions {
   // solved again, from their refined state, as the first frames of the next one, so that
   // no frame is only ever refined at a window's edge (where the temporal terms see one
   // side only). Must be < window. Windows advance by window − window_overlap frames.
-  int window_overlap = 0;
+  // Measured on blob frames 0–11 (end-point error / accuracy P90, mm; refinement frame
+  // solves): 0 → 0.0593 / 0.538 (12), 1 → 0.0536 / 0.553 (14), 2 → 0.0527 / 0.540 (16).
+  int window_overlap = 2;
   // Visibility/sample updates per level (visibility is recomputed at every level anyway).
   int rounds = 1;
   int max_iterations = 8;          // Ceres iterations per round
