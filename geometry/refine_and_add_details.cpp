@@ -138,10 +138,11 @@ SUBFLOW_KERNEL double MulAdd(double a, double b, double c) {
 
 // Phase 2 over the first `size` vertices of the block; d and out start at its first vertex.
 // Two element-wise loops, each with some of the slow square roots and divisions beside
-// other arithmetic: the cross product c = t1 × t2 and the lengths |c|, |t1| with the
-// degenerate lanes selected (as FramesOfBlock, but the square roots are taken before the
-// selection so that the loop has no branch); then the frame and the output row. The two
-// reciprocal lengths take one division: 1/|c| = |t1| e, 1/|t1| = |c| e, e = 1/(|c| |t1|).
+// other arithmetic: the cross product c = t1 × t2 with the degenerate lanes selected (as
+// FramesOfBlock) and the lengths of the selected c and t1 (exactly 1 on a degenerate lane,
+// so no length needs a selection, which would keep the loop from vectorizing); then the
+// frame and the output row. The two reciprocal lengths take one division:
+// 1/|c| = |t1| e, 1/|t1| = |c| e, e = 1/(|c| |t1|).
 template <bool kFma>
 SUBFLOW_KERNEL void FinishBlock(SynthesisBlock* block, int size, const double* __restrict d,
                                 double* __restrict out) {
