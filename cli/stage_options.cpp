@@ -64,7 +64,7 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
                   "Finest level refined by stereo (-1 = one below the finest level)")->capture_default_str();
   sub->add_option("--window", o->window, "Frames refined jointly")->capture_default_str();
   sub->add_option("--window-overlap", o->window_overlap,
-                  "Frames a window shares with the next one (solved again there; < --window)")
+                  "Frames a window shares with the next one, solved again there (at most --window - 1)")
       ->capture_default_str();
   sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
   sub->add_option("--iterations", o->max_iterations, "Ceres iterations per round")->capture_default_str();

@@ -144,10 +144,10 @@ LevelSampling SampleLevel(const LoopHierarchy& hierarchy, int level, const Posit
 }
 
 // The frame ranges [w0, w1] of the windows over `frames` frames: `window` frames each
-// (fewer at the end), consecutive ones sharing `overlap` frames.
+// (fewer at the end), consecutive ones sharing min(overlap, window − 1) frames.
 std::vector<std::pair<int, int>> Windows(int frames, int window, int overlap) {
   std::vector<std::pair<int, int>> windows;
-  const int step = window - overlap;
+  const int step = window - std::min(overlap, window - 1);
   for (int w0 = 0;; w0 += step) {
     const int w1 = std::min(frames - 1, w0 + window - 1);
     windows.emplace_back(w0, w1);
@@ -752,8 +752,7 @@ void StereoRefinementOptions::Check() const {
   require(coarsest_level >= 0, "coarsest_level", "must be ≥ 0");
   require(normal_only_from_level >= 0, "normal_only_from_level", "must be ≥ 0");
   require(window >= 1, "window", "must be ≥ 1");
-  require(window_overlap >= 0 && window_overlap < window, "window_overlap",
-          "must satisfy 0 ≤ window_overlap < window");
+  require(window_overlap >= 0, "window_overlap", "must be ≥ 0");
   require(rounds >= 1, "rounds", "must be ≥ 1");
   require(max_iterations >= 1, "max_iterations", "must be ≥ 1");
   require(threads >= 0, "threads", "must be ≥ 0");

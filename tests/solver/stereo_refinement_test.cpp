@@ -138,6 +138,8 @@ TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
   EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 2);  // [0, 1], [2]
   options.window = 1;
   EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 3);
+  options.window_overlap = 2;  // at most window − 1 = 0 frames are shared
+  EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 3);
 }
 
 TEST(StereoRefinement, RejectsBadInput) {
@@ -146,7 +148,7 @@ TEST(StereoRefinement, RejectsBadInput) {
   options.window = 0;
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
   options = TestOptions();
-  options.window_overlap = options.window;  // would never advance
+  options.window_overlap = -1;
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
   options = TestOptions();
   options.linear_solver = "magic";
