@@ -25,10 +25,10 @@
 //     signed distance to the outline; masks from the dataset, else the projected visual
 //     hulls);
 //   * regularization, in units of the level's mean edge length h: membrane on the
-//     increments (B_v e_v − mean of the neighbours), temporal second differences of the
-//     trajectories (of the base control points in world coordinates; of the details in
-//     their local frames, which a rigid motion leaves unchanged, so only non-rigid
-//     acceleration is penalized), and a small damping;
+//     increments (B_v e_v − mean of the neighbours), temporal second differences (of the
+//     details' trajectories in their local frames, which a rigid motion leaves unchanged,
+//     so only non-rigid acceleration is penalized; of the increments at level 0, whose
+//     world trajectories accelerate with the rigid motion), and a small damping;
 //   * bounds: |e| ≤ max_step · h per component, and, for the normal-only parametrization,
 //     the working volume (the paper's inequality constraints).
 // NCC blocks use a Cauchy loss (occlusions the z-buffer misses, specularities).
@@ -76,7 +76,9 @@ struct StereoRefinementOptions {
   // side only). At most window − 1 is used (so --window 1 has none); windows advance by
   // window − overlap frames.
   // Measured on blob frames 0–11 (end-point error / accuracy P90, mm; refinement frame
-  // solves): 0 → 0.0593 / 0.538 (12), 1 → 0.0536 / 0.553 (14), 2 → 0.0527 / 0.540 (16).
+  // solves), with the level-0 term on the world trajectories: 0 → 0.0593 / 0.538 (12),
+  // 1 → 0.0536 / 0.553 (14), 2 → 0.0527 / 0.540 (16); with the increments' level-0 term
+  // as now, 0 → 0.0637 / 0.509, 2 → 0.0580 / 0.510.
   int window_overlap = 2;
   // Visibility/sample updates per level (visibility is recomputed at every level anyway).
   int rounds = 1;
