@@ -122,6 +122,23 @@ nlohmann::json ShapeInitReport(const vision::Dataset& dataset, const solver::Sha
   for (const auto& [valence, count] : result.simplify.valence_histogram)
     valences[std::to_string(valence)] = count;
 
+  // Backgrounds estimated from the video (cameras without masks and background image),
+  // with the free-pixel margin they were estimated with; null when none was.
+  nlohmann::json estimated = nullptr;
+  for (size_t c = 0; c < result.estimated_backgrounds.size(); ++c) {
+    const vision::EstimatedBackground& background = result.estimated_backgrounds[c];
+    if (background.frames == 0) continue;
+    if (estimated.is_null())
+      estimated = {{"frames", background.frames},
+                   {"margin", options.silhouettes.background_estimate_margin},
+                   {"seconds", result.estimate_background_seconds},
+                   {"cameras", nlohmann::json::array()}};
+    estimated["cameras"].push_back({{"name", dataset.camera(static_cast<int>(c)).name()},
+                                    {"frames", background.frames},
+                                    {"known_fraction", background.known_fraction},
+                                    {"mean_free_frames", background.mean_free_frames}});
+  }
+
   nlohmann::json frames = nlohmann::json::array();
   double carve = 0, isosurface = 0, fit = 0;
   for (const auto& frame : result.frames) {
@@ -172,6 +189,7 @@ nlohmann::json ShapeInitReport(const vision::Dataset& dataset, const solver::Sha
                            {"valence_histogram", valences},
                            {"simplify_attempts", result.simplify.attempts}}},
             {"levels", levels},
+            {"estimated_background", estimated},
             {"frames", frames},
             {"seconds", {{"carve", carve}, {"isosurface", isosurface}, {"simplify", result.simplify_seconds},
                          {"fit", fit}}}}}};

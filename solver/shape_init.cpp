@@ -84,6 +84,17 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   result.reference_frame = reference;
   result.frames.resize(count);
 
+  // Without masks and background images: backgrounds estimated from the video.
+  auto estimate_start = std::chrono::steady_clock::now();
+  result.estimated_backgrounds = vision::EstimateBackgrounds(dataset, options.silhouettes);
+  result.estimate_background_seconds = SecondsSince(estimate_start);
+  for (const vision::EstimatedBackground& estimated : result.estimated_backgrounds)
+    if (estimated.valid()) {
+      spdlog::info("no masks, no background: background estimated from {} frames per camera ({:.1f} s)",
+                   estimated.frames, result.estimate_background_seconds);
+      break;
+    }
+
   // Visual hull of every frame with evidence.
   std::vector<bool> has_evidence(count, false);
   ProgressBegin(progress, "visual hull", count);
@@ -92,7 +103,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     frame.frame = frame.hull_from_frame = first + i;
     auto start = std::chrono::steady_clock::now();
     const std::vector<vision::Silhouette> silhouettes =
-        vision::ComputeFrameEvidence(dataset, frame.frame, options.silhouettes);
+        vision::ComputeFrameEvidence(dataset, frame.frame, options.silhouettes, &result.estimated_backgrounds);
     has_evidence[i] = !vision::LacksEvidence(silhouettes, options.carving.min_cameras);
     if (has_evidence[i]) {
       frame.carving = vision::CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), options.carving,
@@ -107,6 +118,8 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     ProgressUpdate(progress, i + 1);
   }
   ProgressEnd(progress);
+  for (vision::EstimatedBackground& estimated : result.estimated_backgrounds)  // memory: keep the figures
+    estimated.image.release(), estimated.known.release();
   TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, options.carving.min_cameras, &result.frames);
 
   // Base mesh and hierarchy from the reference frame.

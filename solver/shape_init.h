@@ -70,6 +70,11 @@ struct ShapeInitResult {
   geometry::SimplifySummary simplify;
   std::shared_ptr<const geometry::LoopHierarchy> hierarchy;
   std::vector<FrameShapeInit> frames;  // in frame order
+  // Per camera, the background estimated from the video (vision::EstimateBackgrounds;
+  // the figures only, images released) for cameras without masks and background image;
+  // empty when none was estimated.
+  std::vector<vision::EstimatedBackground> estimated_backgrounds;
+  double estimate_background_seconds = 0;
   double simplify_seconds = 0;
 };
 

@@ -2,6 +2,7 @@
 // vision/silhouettes.h and vision/voxel_carving.h), kept apart so that code using only
 // the image-level functions does not link the dataset reader.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -23,8 +24,47 @@ bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras) 
   return non_empty < min_cameras;
 }
 
+namespace {
+
+// Whether camera `camera` would take motion evidence under options.source.
+bool UsesMotion(const Dataset& dataset, int camera, const SilhouetteOptions& options) {
+  if (options.source != EvidenceSource::kAuto) return options.source == EvidenceSource::kMotion;
+  return !dataset.has_masks() && !std::filesystem::exists(dataset.BackgroundPath(camera));
+}
+
+}  // namespace
+
+std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, const SilhouetteOptions& options) {
+  options.Check();
+  const int frame_count = dataset.frame_count();
+  if (!options.estimate_background || options.source != EvidenceSource::kAuto ||
+      frame_count < options.background_estimate_min_frames)
+    return {};
+  constexpr int kMaxFrames = 64;
+  const int used = std::min(frame_count, kMaxFrames);
+  std::vector<int> frames(used);
+  for (int i = 0; i < used; ++i)
+    frames[i] = used == frame_count ? i : static_cast<int>(std::lround(i * (frame_count - 1.0) / (used - 1)));
+  const int camera_count = dataset.camera_count();
+  std::vector<EstimatedBackground> estimated(camera_count);
+  bool any = false;
+  for (int c = 0; c < camera_count; ++c) any = any || UsesMotion(dataset, c, options);
+  if (!any) return {};
+  tbb::parallel_for(0, camera_count, [&](int c) {
+    if (!UsesMotion(dataset, c, options)) return;
+    std::vector<cv::Mat> images, gray;
+    for (int g : frames) {
+      images.push_back(dataset.Image(c, g));
+      gray.push_back(dataset.Gray(c, g));
+    }
+    estimated[c] = EstimateBackground(images, gray, options);
+  });
+  return estimated;
+}
+
 std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
-                                             const SilhouetteOptions& options) {
+                                             const SilhouetteOptions& options,
+                                             const std::vector<EstimatedBackground>* estimated) {
   options.Check();
   const std::string& source_name = dataset.directory();
   if (frame < 0 || frame >= dataset.frame_count())
@@ -52,6 +92,11 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
 
   std::vector<Silhouette> silhouettes(camera_count);
   tbb::parallel_for(0, camera_count, [&](int c) {
+    if (sources[c] == EvidenceSource::kMotion && options.source == EvidenceSource::kAuto && estimated != nullptr &&
+        c < static_cast<int>(estimated->size()) && (*estimated)[c].valid()) {
+      silhouettes[c] = SilhouetteFromEstimatedBackground(dataset.Image(c, frame), (*estimated)[c], options);
+      return;
+    }
     switch (sources[c]) {
       case EvidenceSource::kMask:
         silhouettes[c] = SilhouetteFromMask(dataset.Mask(c, frame), options);

@@ -107,6 +107,10 @@ void SilhouetteOptions::Check() const {
              "a finite value (negative = automatic)", motion_threshold);
   CheckRange(motion_min_threshold >= 0 && std::isfinite(motion_min_threshold),
              "motion_min_threshold", "a non-negative value", motion_min_threshold);
+  CheckRange(background_estimate_min_frames >= 2 && background_estimate_min_frames <= 1000,
+             "background_estimate_min_frames", "an integer in [2, 1000]", background_estimate_min_frames);
+  CheckRange(background_estimate_margin >= 0 && background_estimate_margin <= 100, "background_estimate_margin",
+             "an integer in [0, 100] pixels", background_estimate_margin);
   CheckRange(background_open_radius >= 0 && background_open_radius <= 100, "background_open_radius",
              "an integer in [0, 100] pixels", background_open_radius);
   CheckRange(close_radius >= 0 && close_radius <= 100, "close_radius",
@@ -292,10 +296,11 @@ cv::Mat BackgroundDifference(const cv::Mat& image, const cv::Mat& background) {
   return distance;
 }
 
-Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& background,
-                                    const SilhouetteOptions& options) {
-  const cv::Mat measure = Smooth(BackgroundDifference(image, background),
-                                 options.background_blur_sigma);
+namespace {
+
+// Blurs a background difference, thresholds, cleans and corrects the contour.
+Silhouette SilhouetteFromDifference(const cv::Mat& difference, const SilhouetteOptions& options) {
+  const cv::Mat measure = Smooth(difference, options.background_blur_sigma);
   const double threshold = AutomaticThreshold(measure, options.background_threshold, options.background_method,
                                               options.background_min_threshold);
   Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius);
@@ -304,6 +309,13 @@ Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& backgro
     SetMask(HalfContrastContour(measure, silhouette.mask, options.background_contour_fraction), options,
             &silhouette);
   return silhouette;
+}
+
+}  // namespace
+
+Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& background,
+                                    const SilhouetteOptions& options) {
+  return SilhouetteFromDifference(BackgroundDifference(image, background), options);
 }
 
 cv::Mat MotionEvidence(const std::vector<cv::Mat>& gray_frames, int index,
@@ -346,6 +358,69 @@ Silhouette SilhouetteFromMotion(const std::vector<cv::Mat>& gray_frames, int ind
   Silhouette silhouette = ThresholdAndClean(measure, threshold, options);
   silhouette.source = EvidenceSource::kMotion;
   return silhouette;
+}
+
+EstimatedBackground EstimateBackground(const std::vector<cv::Mat>& images,
+                                       const std::vector<cv::Mat>& gray_frames,
+                                       const SilhouetteOptions& options) {
+  const int count = static_cast<int>(images.size());
+  if (count < 2 || gray_frames.size() != images.size())
+    ThrowError("", "background estimate",
+               "expected at least 2 frames and as many gray frames, got " + std::to_string(count) + " and " +
+                   std::to_string(gray_frames.size()));
+  std::vector<cv::Mat> frames(count), free(count);
+  bool moves = false;
+  for (int g = 0; g < count; ++g) {
+    frames[g] = ToUnitFloat(images[g]);
+    if (frames[g].size() != frames[0].size() || frames[g].type() != frames[0].type() ||
+        gray_frames[g].size() != frames[0].size())
+      ThrowError("", "background estimate", "expected frames of one size and type");
+    const Silhouette motion = SilhouetteFromMotion(gray_frames, g, options);
+    moves = moves || !motion.empty;
+    cv::Mat object = motion.mask;
+    if (options.background_estimate_margin > 0)
+      cv::dilate(object, object, Disk(options.background_estimate_margin));
+    free[g] = object == 0;
+  }
+  EstimatedBackground result;
+  if (!moves) return result;  // nothing moves: the "background" would be the object too
+  const int channels = frames[0].channels(), rows = frames[0].rows, cols = frames[0].cols;
+  result.frames = count;
+  result.image = cv::Mat::zeros(rows, cols, frames[0].type());
+  result.known = cv::Mat::zeros(rows, cols, CV_8UC1);
+  std::vector<float> values(count);
+  long known = 0, free_total = 0;
+  for (int y = 0; y < rows; ++y) {
+    float* out = result.image.ptr<float>(y);
+    uint8_t* known_row = result.known.ptr<uint8_t>(y);
+    for (int x = 0; x < cols; ++x) {
+      for (int c = 0; c < channels; ++c) {
+        int n = 0;
+        for (int g = 0; g < count; ++g)
+          if (free[g].at<uint8_t>(y, x)) values[n++] = frames[g].ptr<float>(y)[x * channels + c];
+        if (n == 0) break;
+        // The lower median (an even count takes the lower of the two middle values).
+        std::nth_element(values.begin(), values.begin() + (n - 1) / 2, values.begin() + n);
+        out[x * channels + c] = values[(n - 1) / 2];
+        if (c == 0) {
+          known_row[x] = 255;
+          ++known;
+          free_total += n;
+        }
+      }
+    }
+  }
+  result.known_fraction = static_cast<double>(known) / (static_cast<double>(rows) * cols);
+  result.mean_free_frames = known > 0 ? static_cast<double>(free_total) / known : 0.0;
+  return result;
+}
+
+Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const EstimatedBackground& background,
+                                             const SilhouetteOptions& options) {
+  SUBFLOW_CHECK(background.valid(), "SilhouetteFromEstimatedBackground without a background");
+  cv::Mat difference = BackgroundDifference(ToUnitFloat(image), background.image);
+  difference.setTo(1.0f, background.known == 0);
+  return SilhouetteFromDifference(difference, options);
 }
 
 }  // namespace subflow::vision

@@ -265,6 +265,7 @@ TEST(ShapeInitBadInput, FrameWithoutMasksAndMotionTakesTheHullOfItsNearestFrameW
   const vision::Dataset dataset(directory.string());
   ShapeInitOptions options = QuickOptions();
   options.silhouettes.motion_window = 0;
+  options.silhouettes.estimate_background = false;  // motion evidence itself (not a background from it)
   options.reference_frame = 3;
   const ShapeInitResult result = InitializeShape(dataset, options);
   ASSERT_EQ(result.frames.size(), 5u);
@@ -280,6 +281,73 @@ TEST(ShapeInitBadInput, FrameWithoutMasksAndMotionTakesTheHullOfItsNearestFrameW
   }
   EXPECT_EQ(result.frames[0].hull.V, result.frames[2].hull.V);
   EXPECT_EQ(result.frames[1].hull.V, result.frames[2].hull.V);
+}
+
+// Mean IoU over cameras of `silhouettes` against the true masks of `truth` at `frame`.
+double MeanIouAgainstMasks(const std::vector<vision::Silhouette>& silhouettes, const vision::Dataset& truth,
+                           int frame) {
+  double sum = 0;
+  for (int c = 0; c < truth.camera_count(); ++c) {
+    const cv::Mat mask = truth.Mask(c, frame) != 0, found = silhouettes[c].mask != 0;
+    const int intersection = cv::countNonZero(mask & found), united = cv::countNonZero(mask | found);
+    sum += united > 0 ? static_cast<double>(intersection) / united : 1.0;
+  }
+  return sum / truth.camera_count();
+}
+
+// Without masks and background, the background estimated from the video (median over
+// the frames where motion evidence leaves a pixel free) gives silhouettes closer to
+// the true masks than raw motion evidence, which fires only where texture moves.
+TEST(ShapeInit, BackgroundEstimatedFromTheVideoGivesBetterSilhouettesThanMotionEvidence) {
+  const fs::path truth_directory = Scratch().FreshPath("estimate_truth");
+  vision::SynthOptions synth;
+  synth.scene.scene = "blob";
+  synth.scene.frame_count = 8;
+  synth.rig.rig = "ring";
+  synth.rig.camera_count = 4;
+  synth.rig.width = 240;
+  synth.rig.height = 180;
+  synth.render.supersample = 2;
+  synth.colour_cameras = {0};
+  vision::WriteSyntheticDataset(truth_directory.string(), synth);
+  const fs::path directory = Scratch().FreshPath("estimate");
+  fs::copy(truth_directory, directory, fs::copy_options::recursive);
+  fs::remove_all(directory / "masks");
+  fs::remove_all(directory / "background");
+  const vision::Dataset truth(truth_directory.string()), dataset(directory.string());
+
+  vision::SilhouetteOptions options;
+  const std::vector<vision::EstimatedBackground> estimated = vision::EstimateBackgrounds(dataset, options);
+  ASSERT_EQ(static_cast<int>(estimated.size()), dataset.camera_count());
+  double estimated_iou = 0, motion_iou = 0;
+  for (int frame = 0; frame < dataset.frame_count(); ++frame) {
+    const auto from_background = vision::ComputeFrameEvidence(dataset, frame, options, &estimated);
+    const auto from_motion = vision::ComputeFrameEvidence(dataset, frame, options);
+    for (int c = 0; c < dataset.camera_count(); ++c) {
+      EXPECT_EQ(from_background[c].source, vision::EvidenceSource::kBackground);
+      EXPECT_EQ(from_motion[c].source, vision::EvidenceSource::kMotion);
+    }
+    estimated_iou += MeanIouAgainstMasks(from_background, truth, frame) / dataset.frame_count();
+    motion_iou += MeanIouAgainstMasks(from_motion, truth, frame) / dataset.frame_count();
+  }
+  for (const vision::EstimatedBackground& background : estimated) {
+    EXPECT_EQ(background.frames, dataset.frame_count());
+    EXPECT_GT(background.known_fraction, 0.5);
+  }
+  std::printf("mean silhouette IoU vs the true masks: estimated background %.4f, motion evidence %.4f\n",
+              estimated_iou, motion_iou);
+  // Measured: 0.954 from the estimated background, 0.929 from motion evidence.
+  constexpr double kFloor = 0.945;
+  EXPECT_GT(estimated_iou, kFloor);
+  EXPECT_LT(motion_iou, kFloor);
+
+  // InitializeShape estimates the backgrounds itself and keeps their figures.
+  ShapeInitOptions quick = QuickOptions();
+  quick.frame_count = 2;
+  const ShapeInitResult result = InitializeShape(dataset, quick);
+  ASSERT_EQ(static_cast<int>(result.estimated_backgrounds.size()), dataset.camera_count());
+  EXPECT_EQ(result.estimated_backgrounds[0].frames, dataset.frame_count());
+  EXPECT_EQ(result.frames[0].carving.cameras[0].source, vision::EvidenceSource::kBackground);
 }
 
 TEST(ShapeInitBadInput, NoMasksNoBackgroundAndNoMotionIsAnErrorThatSaysSo) {
