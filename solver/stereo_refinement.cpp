@@ -517,7 +517,6 @@ void LevelRefiner::SolveWindow(int level, int dof, int w0, int w1, const LevelSa
       if (options_.silhouette_weight > 0) {
         const int s = first + m / 2;
         const Eigen::Vector3d X = state.positions.row(s).transpose();
-        const Eigen::Vector3d n = state.normals.row(s).transpose();
         for (int k = 0; k < static_cast<int>(cameras_.size()); ++k) {
           if (!distances[k]) continue;
           double depth = 0.0;
