@@ -26,10 +26,19 @@ bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras) 
 
 namespace {
 
+// The evidence of camera `camera` for EvidenceSource::kAuto: masks, else the background
+// image, else motion.
+EvidenceSource AutomaticSource(const Dataset& dataset, int camera) {
+  return dataset.has_masks()                                    ? EvidenceSource::kMask
+         : std::filesystem::exists(dataset.BackgroundPath(camera)) ? EvidenceSource::kBackground
+                                                                   : EvidenceSource::kMotion;
+}
+
 // Whether camera `camera` would take motion evidence under options.source.
 bool UsesMotion(const Dataset& dataset, int camera, const SilhouetteOptions& options) {
-  if (options.source != EvidenceSource::kAuto) return options.source == EvidenceSource::kMotion;
-  return !dataset.has_masks() && !std::filesystem::exists(dataset.BackgroundPath(camera));
+  const EvidenceSource source = options.source == EvidenceSource::kAuto ? AutomaticSource(dataset, camera)
+                                                                         : options.source;
+  return source == EvidenceSource::kMotion;
 }
 
 }  // namespace
@@ -80,14 +89,10 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
   const int camera_count = dataset.camera_count();
   std::vector<EvidenceSource> sources(camera_count, options.source);
   for (int c = 0; c < camera_count; ++c) {
-    const bool has_background = std::filesystem::exists(dataset.BackgroundPath(c));
-    if (options.source == EvidenceSource::kBackground && !has_background)
+    if (options.source == EvidenceSource::kBackground && !std::filesystem::exists(dataset.BackgroundPath(c)))
       ThrowError(dataset.BackgroundPath(c), "background",
                  "evidence source \"background\" asked for, but this file does not exist");
-    if (options.source == EvidenceSource::kAuto)
-      sources[c] = dataset.has_masks() ? EvidenceSource::kMask
-                   : has_background     ? EvidenceSource::kBackground
-                                        : EvidenceSource::kMotion;
+    if (options.source == EvidenceSource::kAuto) sources[c] = AutomaticSource(dataset, c);
   }
 
   std::vector<Silhouette> silhouettes(camera_count);

@@ -6,7 +6,6 @@
 #include <memory>
 #include <numeric>
 
-#include <Eigen/Geometry>
 #include <tbb/parallel_for.h>
 
 #include "geometry/error.h"
@@ -41,11 +40,10 @@ std::vector<double> SampleDistances(const TriangleMesh& from, const ClosestPoint
   return ToVector(to.Distances(SampleSurface(from, samples)));
 }
 
-// The motion of each result vertex's closest true material point from frame f to f + 1.
-// The true motion of the closest true point of every result vertex, and the unit normal
-// of the true face it lies on.
-Positions TrueMotion(const Positions& result_vertices, const TriangleMesh& truth,
-                     const ClosestPointTree& truth_tree, const TriangleMesh& truth_next,
+// The motion of each result vertex's closest true material point from frame f to f + 1,
+// and the unit normal of the true face that point lies on (`truth_face_normals`: of frame f).
+Positions TrueMotion(const Positions& result_vertices, const ClosestPointTree& truth_tree,
+                     const Positions& truth_face_normals, const TriangleMesh& truth_next,
                      Positions* truth_normals) {
   const std::vector<geometry::SurfacePoint> closest = truth_tree.ClosestPoints(result_vertices);
   Positions motion(result_vertices.rows(), 3);
@@ -54,8 +52,7 @@ Positions TrueMotion(const Positions& result_vertices, const TriangleMesh& truth
     const Eigen::Vector3d next =
         geometry::FacePoint(truth_next.V, truth_next.F, closest[i].face, closest[i].barycentric);
     motion.row(i) = (next - closest[i].point).transpose();
-    const auto corner = [&](int k) { return Eigen::Vector3d(truth.V.row(truth.F(closest[i].face, k))); };
-    truth_normals->row(i) = (corner(1) - corner(0)).cross(corner(2) - corner(0)).normalized().transpose();
+    truth_normals->row(i) = truth_face_normals.row(closest[i].face);
   }
   return motion;
 }
@@ -177,7 +174,8 @@ EvaluationReport EvaluateSequence(int frame_count,
       const Positions recovered = has_motion ? *result.motion : Positions(result_next.mesh.V - result.mesh.V);
       SUBFLOW_CHECK(recovered.rows() == result.mesh.V.rows(), "one motion vector per vertex");
       Positions truth_normals;
-      const Positions true_motion = TrueMotion(result.mesh.V, truth, truth_tree, truth_next, &truth_normals);
+      const Positions true_motion = TrueMotion(result.mesh.V, truth_tree, geometry::FaceNormals(truth.V, truth.F),
+                                               truth_next, &truth_normals);
       std::vector<double> epe(static_cast<std::size_t>(true_motion.rows()));
       double frame_motion_sum = 0.0, frame_normal_sum = 0.0, frame_tangential_sum = 0.0;
       for (Eigen::Index i = 0; i < true_motion.rows(); ++i) {
