@@ -24,7 +24,8 @@ void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::
 // --motion-smoothness, --hull-weight.
 void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options);
 
-// --refine-levels, --window, --rounds, --iterations, --linear-solver, --threads, ...
+// --refine-from, --refine-to, --window, --window-overlap, --rounds, --iterations,
+// --linear-solver, --threads, --samples-per-pixel, --max-cameras and the term weights.
 void AddRefinementOptions(CLI::App* app, solver::StereoRefinementOptions* options);
 
 }  // namespace subflow::cli
