@@ -1,7 +1,6 @@
 // `subflow check MESH`: reads a mesh, validates it (geometry/mesh_validation.h) and
 // prints the figures. Exit status 0 when the mesh is valid, 1 when it is invalid or
 // cannot be read (one-line error on stderr).
-#include <chrono>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -9,7 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "geometry/error.h"
+#include "core/error.h"
+#include "core/stopwatch.h"
 #include "geometry/mesh_io.h"
 #include "geometry/mesh_validation.h"
 
@@ -22,24 +22,20 @@ struct CheckSettings {
   bool no_self_intersections = false;
 };
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 void RunCheck(const CheckSettings& settings) {
-  const auto read_start = std::chrono::steady_clock::now();
+  const Stopwatch read_start;
   geometry::MeshReadOptions read_options;
   read_options.require_manifold = false;  // the validation reports non-manifoldness itself
   const geometry::TriangleMesh mesh = geometry::ReadMesh(settings.mesh_path, read_options);
-  const double read_seconds = SecondsSince(read_start);
+  const double read_seconds = read_start.Seconds();
 
   geometry::MeshValidationOptions options;
   options.check_self_intersections_cgal = !settings.no_self_intersections;
   options.check_self_intersections_tetgen = !settings.no_self_intersections;
-  const auto validate_start = std::chrono::steady_clock::now();
+  const Stopwatch validate_start;
   const geometry::MeshValidationReport report =
       geometry::ValidateMesh(mesh, options, settings.mesh_path);
-  const double validate_seconds = SecondsSince(validate_start);
+  const double validate_seconds = validate_start.Seconds();
 
   if (settings.json) {
     nlohmann::ordered_json json;

@@ -4,7 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::cli {
 

@@ -14,7 +14,7 @@
 
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "solver/rigid_motion.h"
 #include "vision/dataset.h"

@@ -11,10 +11,10 @@
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
 #include "cli/report_json.h"
-#include "cli/result_files.h"
+#include "output/result_files.h"
 #include "cli/stage_options.h"
 #include "geometry/mesh_io.h"
-#include "solver/result_writer.h"
+#include "output/result_writer.h"
 #include "solver/shape_init.h"
 #include "vision/dataset.h"
 
@@ -37,7 +37,7 @@ void RunHull(const HullArguments& arguments) {
   options.silhouettes.source = vision::ParseEvidenceSource(arguments.evidence, "--evidence");
   options.Check();
   const vision::Dataset dataset(arguments.dataset);
-  solver::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
 
   ProgressBar progress;
   const solver::ShapeInitResult result = solver::InitializeShape(dataset, options, &progress);
@@ -45,15 +45,15 @@ void RunHull(const HullArguments& arguments) {
   const int finest = hierarchy.finest_level();
 
   const fs::path out(arguments.out);
-  WriteHullFiles(arguments.out, result);
+  output::WriteHullFiles(arguments.out, result);
   std::vector<geometry::Positions> limit_surfaces;
   std::vector<std::vector<geometry::Positions>> control;
   for (const solver::FrameShapeInit& frame : result.frames) {
     control.push_back(frame.control);
     limit_surfaces.push_back(hierarchy.LimitPositions(finest) * frame.control[finest]);
   }
-  WriteControlFiles(arguments.out, hierarchy, result.frames.front().frame, control);
-  solver::WriteResultMeshes(arguments.out, result.frames.front().frame, hierarchy.LevelFaces(finest),
+  output::WriteControlFiles(arguments.out, hierarchy, result.frames.front().frame, control);
+  output::WriteResultMeshes(arguments.out, result.frames.front().frame, hierarchy.LevelFaces(finest),
                             limit_surfaces);
 
   nlohmann::json report = ShapeInitReport(dataset, options, result);
@@ -61,7 +61,7 @@ void RunHull(const HullArguments& arguments) {
   report["output"] = arguments.out;
   report["total_seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  solver::WriteJsonFile((out / "report.json").string(), report);
+  output::WriteJsonFile((out / "report.json").string(), report);
 
   double iou_sum = 0;
   for (const auto& frame : result.frames) iou_sum += frame.carving.mean_silhouette_iou;

@@ -7,7 +7,7 @@
 #include <mutex>
 #include <string>
 
-#include "geometry/progress.h"
+#include "core/progress.h"
 
 namespace subflow::cli {
 

@@ -4,7 +4,6 @@
 // and report.json) and beside it: rigid_vx.., nonrigid_vx.., motion_energy and
 // nonrigid_energy vertex properties in the same PLY files, obj/<frame>.obj, hull/,
 // base_mesh.ply and control/<frame>/level_<i>.ply (the final control hierarchy).
-#include <chrono>
 #include <memory>
 
 #include <spdlog/spdlog.h>
@@ -13,10 +12,11 @@
 #include "cli/progress_bar.h"
 #include "cli/reconstruct_report.h"
 #include "cli/report_json.h"
-#include "cli/result_files.h"
+#include "output/result_files.h"
 #include "cli/stage_options.h"
+#include "core/stopwatch.h"
 #include "solver/reconstruction.h"
-#include "solver/result_writer.h"
+#include "output/result_writer.h"
 #include "vision/dataset.h"
 
 namespace subflow::cli {
@@ -47,13 +47,13 @@ std::map<std::string, std::vector<Eigen::VectorXd>> FlowProperties(const solver:
 }
 
 void RunReconstruct(const ReconstructArguments& arguments) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   solver::ReconstructionOptions options = arguments.options;
   options.shape.silhouettes.source = vision::ParseEvidenceSource(arguments.evidence, "--evidence");
   options.refine = !arguments.no_refine;
   options.Check();
   const vision::Dataset dataset(arguments.dataset);
-  solver::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
 
   ProgressBar progress;
   const solver::ReconstructionResult result = solver::Reconstruct(dataset, options, &progress);
@@ -61,7 +61,7 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   const int finest = hierarchy.finest_level();
   const int frames = static_cast<int>(result.control.size());
 
-  const auto write_start = std::chrono::steady_clock::now();
+  const Stopwatch write_start;
   std::vector<geometry::Positions> surfaces;
   std::vector<std::vector<geometry::Positions>> levels;
   for (int i = 0; i < frames; ++i) {
@@ -69,13 +69,13 @@ void RunReconstruct(const ReconstructArguments& arguments) {
     levels.push_back(result.trajectory[i].SynthesizeLevels(hierarchy, finest));
   }
   const solver::FlowAnalysis flow = solver::AnalyzeFlow(surfaces, result.rigid);
-  solver::WriteResultMeshes(arguments.out, result.first_frame, hierarchy.LevelFaces(finest), surfaces,
+  output::WriteResultMeshes(arguments.out, result.first_frame, hierarchy.LevelFaces(finest), surfaces,
                             FlowProperties(flow));
-  WriteObjSequence(arguments.out, result.first_frame, hierarchy.LevelFaces(finest), surfaces);
-  WriteHullFiles(arguments.out, result.shape);
-  WriteControlFiles(arguments.out, hierarchy, result.first_frame, levels);
+  output::WriteObjSequence(arguments.out, result.first_frame, hierarchy.LevelFaces(finest), surfaces);
+  output::WriteHullFiles(arguments.out, result.shape);
+  output::WriteControlFiles(arguments.out, hierarchy, result.first_frame, levels);
   const double write_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+write_start.Seconds();
 
   nlohmann::json report = ShapeInitReport(dataset, options.shape, result.shape);
   report["command"] = arguments.no_refine ? "reconstruct --no-refine" : "reconstruct";
@@ -93,7 +93,7 @@ void RunReconstruct(const ReconstructArguments& arguments) {
                     {"mean_non_rigid_flow_per_step", mean_non_rigid},
                     {"output_vertices", surfaces.front().rows()},
                     {"output_faces", hierarchy.FaceCount(finest)}};
-  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double total = start.Seconds();
   report["timings_seconds"] = {{"shape_init", result.shape_seconds},
                                {"motion_init", result.motion_seconds},
                                {"refinement", result.refinement_seconds},
@@ -102,7 +102,7 @@ void RunReconstruct(const ReconstructArguments& arguments) {
                                {"writing", write_seconds},
                                {"total", total}};
   report["total_seconds"] = total;
-  solver::WriteJsonFile((std::filesystem::path(arguments.out) / "report.json").string(), report);
+  output::WriteJsonFile((std::filesystem::path(arguments.out) / "report.json").string(), report);
 
   spdlog::info("reconstruct: {} frames, {} vertices per frame, mean flow {:.4g} per step "
                "(non-rigid {:.4g}); shape {:.1f} s, motion {:.1f} s, refinement {:.1f} s, retrack {:.1f} s, "

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "cli/commands.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/mesh_io.h"
 

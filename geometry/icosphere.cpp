@@ -5,7 +5,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 

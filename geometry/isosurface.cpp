@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 namespace {

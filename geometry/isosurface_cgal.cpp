@@ -2,7 +2,6 @@
 // Kept alone in this file because Mesh_3 is the heaviest CGAL package to compile.
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -19,7 +18,8 @@
 #include <CGAL/facets_in_complex_3_to_triangle_mesh.h>
 #include <Eigen/Geometry>
 
-#include "geometry/error.h"
+#include "core/error.h"
+#include "core/stopwatch.h"
 #include "geometry/isosurface.h"
 #include "geometry/mesh_topology.h"
 
@@ -37,10 +37,6 @@ namespace params = CGAL::parameters;
 
 // Surface points are found by bisection on segments down to this length (voxels).
 constexpr double kIntersectionToleranceVoxels = 1e-3;
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Mesh_3 draws from CGAL's default random generator; fix it for the duration of one
 // extraction and give the caller's generator back afterwards.
@@ -131,7 +127,7 @@ TriangleMesh ExtractIsosurface(const ScalarVolume& volume, const IsosurfaceOptio
                    "): the volume does not enclose the object");
 
   IsosurfaceSummary stats;
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   const double sigma = options.smoothing_sigma_voxels;
   const int blur_reach = sigma > 0.0 ? static_cast<int>(std::ceil(3.0 * sigma)) + 1 : 1;
   ScalarVolume field =
@@ -150,9 +146,9 @@ TriangleMesh ExtractIsosurface(const ScalarVolume& volume, const IsosurfaceOptio
                "no voxel is occupied (no value > iso_value " + std::to_string(iso) +
                    " after smoothing with σ = " + std::to_string(sigma) +
                    " voxels): the volume is empty or its objects are thinner than the blur");
-  stats.prepare_seconds = SecondsSince(start);
+  stats.prepare_seconds = start.Seconds();
 
-  start = std::chrono::steady_clock::now();
+  start.Restart();
   const ScopedDefaultRandom scoped_random(options.random_seed);
   CGAL::Random domain_random(options.random_seed);
   const CGAL::Image_3 image = MakeVoxelImage(field);
@@ -174,9 +170,9 @@ TriangleMesh ExtractIsosurface(const ScalarVolume& volume, const IsosurfaceOptio
   CGAL::Mesh_3::Mesher_3<Complex, Criteria, MeshDomain> mesher(
       c3t3, domain, criteria, CGAL::MANIFOLD, static_cast<std::size_t>(options.max_vertex_count));
   mesher.refine_mesh();
-  stats.mesh_seconds = SecondsSince(start);
+  stats.mesh_seconds = start.Seconds();
 
-  start = std::chrono::steady_clock::now();
+  start.Restart();
   TriangleMesh mesh = ExtractBoundary(c3t3, source);
   mesh.V = ((volume.spacing * mesh.V).rowwise() + world_origin.transpose()).eval();
   // What matters downstream: a closed, consistently oriented 2-manifold (MeshTopology throws
@@ -194,7 +190,7 @@ TriangleMesh ExtractIsosurface(const ScalarVolume& volume, const IsosurfaceOptio
   SUBFLOW_CHECK(signed_volume > 0.0, "Mesh_3 facets must be oriented outwards");
   stats.vertex_count = mesh.vertex_count();
   stats.face_count = mesh.face_count();
-  stats.extract_seconds = SecondsSince(start);
+  stats.extract_seconds = start.Seconds();
   if (summary != nullptr) *summary = stats;
   return mesh;
 }

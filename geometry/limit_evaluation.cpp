@@ -11,7 +11,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/loop_box_spline.h"
 #include "geometry/loop_local_patch.h"
 

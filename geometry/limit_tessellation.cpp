@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/local_frames_kernels.h"
 #include "geometry/point_stencil.h"
 

@@ -3,7 +3,7 @@
 #include <limits>
 #include <string>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 

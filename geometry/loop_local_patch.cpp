@@ -4,7 +4,7 @@
 #include <cmath>
 #include <utility>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/loop_box_spline.h"
 
 namespace subflow::geometry::loop_patch {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/point_stencil.h"
 
 namespace subflow::geometry {

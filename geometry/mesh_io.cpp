@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_topology.h"
 #include "geometry/obj_io.h"
 #include "geometry/ply_io.h"

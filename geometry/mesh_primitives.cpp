@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 namespace {

@@ -9,7 +9,7 @@
 #include <Eigen/Geometry>
 #include <spdlog/fmt/fmt.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_topology.h"
 
 namespace subflow::geometry {

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/text_parsing.h"
 
 namespace subflow::geometry {

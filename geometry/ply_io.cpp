@@ -11,7 +11,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/text_parsing.h"
 
 namespace subflow::geometry {

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <set>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 namespace {

@@ -8,7 +8,7 @@
 #include <memory>
 #include <type_traits>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/local_frames.h"
 #include "geometry/local_frames_kernels.h"
 #include "geometry/point_stencil.h"

@@ -1,7 +1,6 @@
 // SimplifyMesh: CGAL edge collapse with Garland–Heckbert quadrics, shape and valence
 // filters, a valence-improving flip pass and a self-intersection guard.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -13,7 +12,8 @@
 #include <CGAL/boost/graph/Euler_operations.h>
 #include <boost/optional.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
+#include "core/stopwatch.h"
 #include "geometry/mesh_topology.h"
 #include "geometry/simplify.h"
 
@@ -175,15 +175,11 @@ int FlipTowardsRegularValence(const SimplifyOptions& options, SurfaceMesh* mesh)
   return flips;
 }
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 }  // namespace
 
 TriangleMesh SimplifyMesh(const TriangleMesh& mesh, const SimplifyOptions& options,
                           SimplifySummary* summary, const std::string& source) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch start;
   options.Check();
   if (mesh.face_count() == 0) ThrowError(source, "faces", "expected at least one triangle");
   if (!mesh.V.allFinite()) ThrowError(source, "vertices", "expected finite coordinates");
@@ -195,7 +191,7 @@ TriangleMesh SimplifyMesh(const TriangleMesh& mesh, const SimplifyOptions& optio
     stats.face_count = stats.input_face_count;
     stats.vertex_count = mesh.vertex_count();
     for (int v = 0; v < mesh.vertex_count(); ++v) ++stats.valence_histogram[topology.Valence(v)];
-    stats.seconds = SecondsSince(start);
+    stats.seconds = start.Seconds();
     if (summary != nullptr) *summary = stats;
     return mesh;
   }
@@ -233,7 +229,7 @@ TriangleMesh SimplifyMesh(const TriangleMesh& mesh, const SimplifyOptions& optio
     ++stats.valence_histogram[simplified_topology.Valence(v)];
   stats.face_count = simplified.face_count();
   stats.vertex_count = simplified.vertex_count();
-  stats.seconds = SecondsSince(start);
+  stats.seconds = start.Seconds();
   if (summary != nullptr) *summary = stats;
   return simplified;
 }

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/loop_box_spline.h"
 
 namespace subflow::geometry::loop_patch {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <utility>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 namespace {

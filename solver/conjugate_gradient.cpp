@@ -5,7 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "solver/block_jacobi_preconditioner.h"
 
 namespace subflow::solver {

@@ -7,7 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::solver {
 namespace {

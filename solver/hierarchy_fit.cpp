@@ -1,6 +1,6 @@
 #include "solver/hierarchy_fit.h"
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/local_frames.h"
 #include "solver/surface_snapping.h"
 

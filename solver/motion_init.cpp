@@ -8,7 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "geometry/closest_point.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "solver/surface_snapping.h"
 
 namespace subflow::solver {

@@ -28,7 +28,7 @@
 
 #include "geometry/loop_hierarchy.h"
 #include "geometry/multires_shape.h"
-#include "geometry/progress.h"
+#include "core/progress.h"
 #include "geometry/triangle_mesh.h"
 #include "solver/motion_step.h"
 #include "solver/rigid_motion.h"

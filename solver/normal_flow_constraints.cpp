@@ -6,7 +6,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::solver {
 namespace {

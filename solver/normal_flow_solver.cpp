@@ -8,7 +8,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/local_frames.h"
 #include "geometry/loop_operators.h"
 #include "solver/conjugate_gradient.h"

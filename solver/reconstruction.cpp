@@ -1,21 +1,15 @@
 #include "solver/reconstruction.h"
 
-#include <chrono>
 
 #include <opencv2/imgproc.hpp>
 #include <spdlog/spdlog.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
+#include "core/stopwatch.h"
 #include "vision/zbuffer.h"
 
 namespace subflow::solver {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 }  // namespace
 
@@ -53,16 +47,16 @@ ReconstructionResult Reconstruct(const vision::Dataset& dataset, const Reconstru
   options.Check();
   ReconstructionResult result;
 
-  auto start = Clock::now();
+  Stopwatch start;
   result.shape = InitializeShape(dataset, options.shape, progress);
-  result.shape_seconds = SecondsSince(start);
+  result.shape_seconds = start.Seconds();
   const geometry::LoopHierarchy& hierarchy = result.hierarchy();
   const int finest = hierarchy.finest_level();
   result.first_frame = result.shape.frames.front().frame;
   const int frames = static_cast<int>(result.shape.frames.size());
 
   // Motion initialization from the reference frame's fit, corrected towards every frame's.
-  start = Clock::now();
+  start.Restart();
   std::vector<geometry::Positions> fitted(frames);
   for (int i = 0; i < frames; ++i) fitted[i] = result.shape.frames[i].control.at(finest);
   const int first = result.first_frame;
@@ -73,33 +67,33 @@ ReconstructionResult Reconstruct(const vision::Dataset& dataset, const Reconstru
   };
   result.motion = InitializeMotion(dataset.cameras(), frames, gray, hierarchy, fitted,
                                    result.shape.reference_frame - first, options.motion, progress);
-  result.motion_seconds = SecondsSince(start);
+  result.motion_seconds = start.Seconds();
   result.control = result.motion.control;
 
   if (options.refine) {
-    start = Clock::now();
+    start.Restart();
     result.refinement = RefineStereo(dataset.cameras(), gray, SilhouetteLoader(dataset, result.shape),
                                      hierarchy, result.control, dataset.bounds(), options.refinement,
                                      progress);
     result.control = result.refinement->control;
-    result.refinement_seconds = SecondsSince(start);
+    result.refinement_seconds = start.Seconds();
     if (options.retrack) {
-      start = Clock::now();
+      start.Restart();
       MotionInitOptions retrack = options.motion;
       retrack.hull_weight = options.retrack_weight;
       result.retrack = InitializeMotion(dataset.cameras(), frames, gray, hierarchy, result.control,
                                         result.shape.reference_frame - first, retrack, progress);
       result.control = result.retrack->control;
-      result.retrack_seconds = SecondsSince(start);
+      result.retrack_seconds = start.Seconds();
     }
   }
 
-  start = Clock::now();
+  start.Restart();
   result.trajectory = geometry::AnalyzeTrajectory(hierarchy, result.control);
   std::vector<geometry::Positions> bases;
   for (const geometry::MultiresShape& shape : result.trajectory) bases.push_back(shape.base());
   result.rigid = FitRigidMotions(bases);
-  result.analysis_seconds = SecondsSince(start);
+  result.analysis_seconds = start.Seconds();
   return result;
 }
 

@@ -10,7 +10,7 @@
 
 #include "geometry/loop_hierarchy.h"
 #include "geometry/multires_shape.h"
-#include "geometry/progress.h"
+#include "core/progress.h"
 #include "solver/motion_init.h"
 #include "solver/rigid_motion.h"
 #include "solver/shape_init.h"

@@ -6,7 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::solver {
 

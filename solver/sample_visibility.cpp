@@ -5,7 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "vision/zbuffer.h"
 
 namespace subflow::solver {

@@ -1,21 +1,17 @@
 #include "solver/shape_init.h"
 
 #include <algorithm>
-#include <chrono>
 #include <string>
 #include <vector>
 
 #include <spdlog/spdlog.h>
 
+#include "core/stopwatch.h"
 #include "geometry/closest_point.h"
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::solver {
 namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Frames without evidence take the hull and carving figures of the nearest frame with
 // evidence (the earlier one on a tie), with a warning; an error when no frame has any.
@@ -85,9 +81,9 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   result.frames.resize(count);
 
   // Without masks and background images: backgrounds estimated from the video.
-  auto estimate_start = std::chrono::steady_clock::now();
+  Stopwatch estimate_start;
   result.estimated_backgrounds = vision::EstimateBackgrounds(dataset, options.silhouettes);
-  result.estimate_background_seconds = SecondsSince(estimate_start);
+  result.estimate_background_seconds = estimate_start.Seconds();
   for (const vision::EstimatedBackground& estimated : result.estimated_backgrounds)
     if (estimated.valid()) {
       spdlog::info("no masks, no background: background estimated from {} frames per camera ({:.1f} s)",
@@ -101,18 +97,18 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   for (int i = 0; i < count; ++i) {
     FrameShapeInit& frame = result.frames[i];
     frame.frame = frame.hull_from_frame = first + i;
-    auto start = std::chrono::steady_clock::now();
+    Stopwatch start;
     const std::vector<vision::Silhouette> silhouettes =
         vision::ComputeFrameEvidence(dataset, frame.frame, options.silhouettes, &result.estimated_backgrounds);
     has_evidence[i] = !vision::LacksEvidence(silhouettes, options.carving.min_cameras);
     if (has_evidence[i]) {
       frame.carving = vision::CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), options.carving,
                                           frame.frame);
-      frame.carve_seconds = SecondsSince(start);
-      start = std::chrono::steady_clock::now();
+      frame.carve_seconds = start.Seconds();
+      start.Restart();
       frame.hull = geometry::ExtractIsosurface(frame.carving.occupancy, options.isosurface, &frame.isosurface,
                                                "occupancy of frame " + vision::FrameName(frame.frame));
-      frame.isosurface_seconds = SecondsSince(start);
+      frame.isosurface_seconds = start.Seconds();
       frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
     }
     ProgressUpdate(progress, i + 1);
@@ -123,12 +119,12 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, options.carving.min_cameras, &result.frames);
 
   // Base mesh and hierarchy from the reference frame.
-  auto start = std::chrono::steady_clock::now();
+  Stopwatch start;
   const FrameShapeInit& reference_frame = result.frames[reference - first];
   result.base_mesh = geometry::SimplifyMesh(reference_frame.hull, options.simplify,
                                             &result.simplify,
                                             "visual hull of frame " + vision::FrameName(reference));
-  result.simplify_seconds = SecondsSince(start);
+  result.simplify_seconds = start.Seconds();
   result.hierarchy = std::make_shared<const geometry::LoopHierarchy>(
       result.base_mesh.F, result.base_mesh.vertex_count(), options.levels, "base mesh");
   spdlog::info("base mesh: {} vertices, {} faces; {} levels, finest {} faces",
@@ -145,7 +141,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   int done = 0;
   for (int i : order) {
     FrameShapeInit& frame = result.frames[i];
-    start = std::chrono::steady_clock::now();
+    start.Restart();
     const int neighbour = i < reference - first ? i + 1 : i - 1;
     const geometry::Positions& initial_base =
         i == reference - first ? result.base_mesh.V : result.frames[neighbour].control.front();
@@ -154,7 +150,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     frame.control = FitHierarchyToSurface(*result.hierarchy, initial_base, hull_tree,
                                           options.fit, &frame.fit);
     frame.shape = geometry::MultiresShape::Analyze(*result.hierarchy, frame.control.back());
-    frame.fit_seconds = SecondsSince(start);
+    frame.fit_seconds = start.Seconds();
     ProgressUpdate(progress, ++done);
   }
   ProgressEnd(progress);

@@ -22,7 +22,7 @@
 #include "geometry/isosurface.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/multires_shape.h"
-#include "geometry/progress.h"
+#include "core/progress.h"
 #include "geometry/simplify.h"
 #include "solver/hierarchy_fit.h"
 #include "vision/dataset.h"

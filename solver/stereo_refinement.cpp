@@ -1,7 +1,6 @@
 #include "solver/stereo_refinement.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -13,7 +12,8 @@
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
+#include "core/stopwatch.h"
 #include "geometry/limit_evaluation.h"
 #include "geometry/local_frames.h"
 #include "geometry/multires_shape.h"
@@ -25,12 +25,6 @@ namespace {
 
 using geometry::LoopHierarchy;
 using geometry::Positions;
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 ceres::LinearSolverType ParseLinearSolver(const std::string& name) {
   if (name == "sparse_normal_cholesky") return ceres::SPARSE_NORMAL_CHOLESKY;
   if (name == "cgnr") return ceres::CGNR;
@@ -354,7 +348,7 @@ class LevelRefiner {
 void LevelRefiner::Run(int level, const std::vector<char>& active_faces,
                        std::vector<char>* moved_vertices, Progress* progress,
                        std::size_t* progress_done) {
-  const auto start = Clock::now();
+  const Stopwatch start;
   const int frames = static_cast<int>(control_.size());
   const int dof = level >= options_.normal_only_from_level ? 1 : 3;
   const int reference = frames / 2;
@@ -390,7 +384,7 @@ void LevelRefiner::Run(int level, const std::vector<char>& active_faces,
     (*moved_vertices)[v] = moved[v] > options_.adaptive_threshold * h ? 1 : 0;
   }
   report.mean_increment = moved_sum / static_cast<double>(moved.size());
-  report.seconds = SecondsSince(start);
+  report.seconds = start.Seconds();
   spdlog::info("refinement level {}: {} of {} patches, dof {}, {} unknowns, {} residual blocks, "
                "{} iterations, mean max |increment| {:.3g}, {:.1f} s ({:.1f} s in Ceres)",
                level, report.active_patches, report.patches, dof, report.parameters,
@@ -667,9 +661,9 @@ void LevelRefiner::SolveWindow(int level, int dof, int w0, int w1, const LevelSa
   solver_options.function_tolerance = 1e-4;
   ceres::Solver::Summary summary;
   if (problem.NumParameterBlocks() > 0 && problem.NumResidualBlocks() > 0) {
-    const auto solve_start = Clock::now();
+    const Stopwatch solve_start;
     ceres::Solve(solver_options, &problem, &summary);
-    report->solver_seconds += SecondsSince(solve_start);
+    report->solver_seconds += solve_start.Seconds();
     report->iterations += static_cast<int>(summary.iterations.size());
     spdlog::debug("refinement level {} frames {}–{}: {}; jacobians {:.2f} s, residuals {:.2f} s, "
                   "linear solver {:.2f} s", level, w0, w1, summary.BriefReport(),
@@ -784,7 +778,7 @@ RefinementResult RefineStereo(const std::vector<vision::Camera>& cameras,
                               const LoopHierarchy& hierarchy, const std::vector<Positions>& control,
                               const vision::Bounds& bounds, const StereoRefinementOptions& options,
                               Progress* progress) {
-  const auto start = Clock::now();
+  const Stopwatch start;
   options.Check();
   if (cameras.size() < 2) ThrowError("stereo refinement", "cameras", "needs at least 2 cameras");
   if (control.empty()) ThrowError("stereo refinement", "control", "needs at least one frame");
@@ -831,7 +825,7 @@ RefinementResult RefineStereo(const std::vector<vision::Camera>& cameras,
     active = std::move(next);
   }
   ProgressEnd(progress);
-  result.seconds = SecondsSince(start);
+  result.seconds = start.Seconds();
   return result;
 }
 

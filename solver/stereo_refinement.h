@@ -46,7 +46,7 @@
 #include <opencv2/core.hpp>
 
 #include "geometry/loop_hierarchy.h"
-#include "geometry/progress.h"
+#include "core/progress.h"
 #include "geometry/triangle_mesh.h"
 #include "solver/sample_visibility.h"
 #include "vision/camera.h"

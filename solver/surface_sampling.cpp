@@ -7,7 +7,7 @@
 #include <Eigen/Geometry>
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::solver {
 

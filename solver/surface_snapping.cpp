@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/local_frames.h"
 
 namespace subflow::solver {

@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::vision {
 namespace {

@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "vision/dataset.h"
 #include "vision/dataset_writer.h"
 

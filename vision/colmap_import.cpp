@@ -9,7 +9,7 @@
 
 #include <Eigen/Geometry>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::vision {
 namespace fs = std::filesystem;

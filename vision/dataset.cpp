@@ -13,7 +13,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "vision/dataset_layout.h"
 
 namespace subflow::vision {

@@ -8,7 +8,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "vision/dataset.h"
 #include "vision/silhouettes.h"
 #include "vision/voxel_carving.h"

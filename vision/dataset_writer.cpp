@@ -4,7 +4,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 
 namespace subflow::vision {

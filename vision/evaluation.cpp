@@ -8,7 +8,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/vertex_normals.h"
 
 namespace subflow::vision {

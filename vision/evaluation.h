@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "geometry/closest_point.h"
-#include "geometry/progress.h"
+#include "core/progress.h"
 #include "geometry/triangle_mesh.h"
 
 namespace subflow::vision {

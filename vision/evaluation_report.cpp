@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "vision/evaluation.h"
 

@@ -2,7 +2,7 @@
 
 #include <cstdint>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::vision {
 

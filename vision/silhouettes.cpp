@@ -6,7 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::vision {
 namespace {

@@ -11,7 +11,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/vertex_normals.h"
 #include "vision/dataset_writer.h"
 #include "vision/zbuffer.h"

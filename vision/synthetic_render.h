@@ -24,7 +24,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "geometry/progress.h"
+#include "core/progress.h"
 #include "geometry/triangle_mesh.h"
 #include "vision/camera.h"
 #include "vision/camera_rig.h"

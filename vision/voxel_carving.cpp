@@ -11,7 +11,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "vision/voxel_morphology.h"
 #include "vision/voxel_projection.h"
 

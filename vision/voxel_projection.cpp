@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::vision {
 namespace {

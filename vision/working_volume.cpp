@@ -7,7 +7,7 @@
 
 #include <Eigen/Dense>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::vision {
 namespace {

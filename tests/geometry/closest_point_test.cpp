@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/icosphere.h"
 
 namespace subflow::geometry {

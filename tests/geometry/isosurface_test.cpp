@@ -8,7 +8,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_topology.h"
 
 namespace subflow::geometry {

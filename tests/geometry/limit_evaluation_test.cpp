@@ -22,7 +22,7 @@
 #include <CGAL/subdivision_method_3.h>
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/limit_evaluation.h"
 #include "geometry/limit_tessellation.h"
 #include "geometry/loop_box_spline.h"

@@ -13,7 +13,7 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/icosphere.h"
 #include "geometry/limit_evaluation.h"
 #include "geometry/limit_tessellation.h"

@@ -10,7 +10,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/icosphere.h"
 #include "geometry/local_frames.h"
 #include "geometry/mesh_primitives.h"

@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "tests/test_support.h"
 
 namespace subflow::geometry {

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::geometry {
 namespace {

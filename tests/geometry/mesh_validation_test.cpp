@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 
 namespace subflow::geometry {

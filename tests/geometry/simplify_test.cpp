@@ -15,7 +15,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/isosurface.h"
 #include "geometry/mesh_topology.h"
 

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "geometry/closest_point.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/icosphere.h"
 #include "geometry/loop_hierarchy.h"
 

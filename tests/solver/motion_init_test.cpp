@@ -9,7 +9,7 @@
 #include <Eigen/LU>
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "solver/rigid_motion.h"
 #include "tests/solver/motion_test_scene.h"
 

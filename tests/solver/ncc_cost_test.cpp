@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "solver/ncc_cost.h"
 #include "vision/camera_rig.h"
 

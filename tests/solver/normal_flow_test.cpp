@@ -9,7 +9,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "solver/constraint_collinearity.h"
 #include "solver/image_derivatives.h"
 #include "solver/normal_flow_constraints.h"

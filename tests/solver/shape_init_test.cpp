@@ -19,7 +19,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "geometry/closest_point.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "tests/test_support.h"
 #include "vision/synthetic_render.h"

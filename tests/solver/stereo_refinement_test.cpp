@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "geometry/closest_point.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/limit_tessellation.h"
 #include "geometry/local_frames.h"
 #include "geometry/multires_shape.h"

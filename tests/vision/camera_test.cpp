@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 
 namespace subflow::vision {
 namespace {

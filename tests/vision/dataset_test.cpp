@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "vision/dataset_writer.h"
 #include "tests/test_support.h"

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "geometry/closest_point.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/vertex_normals.h"
 #include "vision/dataset.h"

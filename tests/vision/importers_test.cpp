@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "vision/colmap_import.h"
 #include "vision/projection_matrix_import.h"
 #include "tests/test_support.h"

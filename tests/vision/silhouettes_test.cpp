@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "vision/dataset.h"
 #include "vision/dataset_writer.h"
 #include "vision/voxel_carving.h"

@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "vision/dataset.h"
 #include "vision/mask_agreement.h"

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "vision/dataset.h"
 #include "vision/voxel_morphology.h"

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "geometry/closest_point.h"
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/icosphere.h"
 #include "geometry/mesh_io.h"
 #include "vision/camera_rig.h"

@@ -16,7 +16,7 @@
 
 #include "geometry/triangle_mesh.h"
 
-namespace subflow::solver {
+namespace subflow::output {
 
 // Creates `directory` (and its parents). Throws subflow::Error naming it when it exists
 // and is not empty and `overwrite` is false, or when it cannot be created.
@@ -33,4 +33,4 @@ void WriteResultMeshes(const std::string& directory, int first_frame, const geom
 // Writes `json` pretty-printed to `path` (through "<path>.tmp" and a rename).
 void WriteJsonFile(const std::string& path, const nlohmann::json& json);
 
-}  // namespace subflow::solver
+}  // namespace subflow::output

@@ -1,13 +1,13 @@
-#include "solver/result_writer.h"
+#include "output/result_writer.h"
 
 #include <filesystem>
 #include <fstream>
 
-#include "geometry/error.h"
+#include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "vision/dataset.h"
 
-namespace subflow::solver {
+namespace subflow::output {
 
 namespace fs = std::filesystem;
 
@@ -67,4 +67,4 @@ void WriteJsonFile(const std::string& path, const nlohmann::json& json) {
   if (error) ThrowError(path, "", "cannot rename the temporary file: " + error.message());
 }
 
-}  // namespace subflow::solver
+}  // namespace subflow::output

@@ -1,11 +1,11 @@
-#include "cli/result_files.h"
+#include "output/result_files.h"
 
 #include <filesystem>
 
 #include "geometry/mesh_io.h"
 #include "vision/dataset.h"
 
-namespace subflow::cli {
+namespace subflow::output {
 
 namespace fs = std::filesystem;
 
@@ -38,4 +38,4 @@ void WriteObjSequence(const std::string& out, int first_frame, const geometry::F
                         geometry::TriangleMesh{positions[i], faces});
 }
 
-}  // namespace subflow::cli
+}  // namespace subflow::output

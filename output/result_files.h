@@ -12,7 +12,7 @@
 #include "geometry/triangle_mesh.h"
 #include "solver/shape_init.h"
 
-namespace subflow::cli {
+namespace subflow::output {
 
 // hull/<frame>.ply and base_mesh.ply.
 void WriteHullFiles(const std::string& out, const solver::ShapeInitResult& result);
@@ -26,4 +26,4 @@ void WriteControlFiles(const std::string& out, const geometry::LoopHierarchy& hi
 void WriteObjSequence(const std::string& out, int first_frame, const geometry::Faces& faces,
                       const std::vector<geometry::Positions>& positions);
 
-}  // namespace subflow::cli
+}  // namespace subflow::output
