@@ -65,8 +65,11 @@ Camera::Camera(std::string name, int width, int height, const Eigen::Matrix3d& K
   auto fail = [&](const std::string& field, const std::string& problem) {
     ThrowError(source, where + ": " + field, problem);
   };
-  if (width <= 0) fail("width", "expected a positive integer, got " + std::to_string(width));
-  if (height <= 0) fail("height", "expected a positive integer, got " + std::to_string(height));
+  const std::string side_range = "[1, " + std::to_string(kMaxImageSide) + "]";
+  if (width <= 0 || width > kMaxImageSide)
+    fail("width", "expected an integer in " + side_range + ", got " + std::to_string(width));
+  if (height <= 0 || height > kMaxImageSide)
+    fail("height", "expected an integer in " + side_range + ", got " + std::to_string(height));
   if (!K.allFinite()) fail("K", "expected finite values, got " + Describe(K));
   if (K(1, 0) != 0 || K(2, 0) != 0 || K(2, 1) != 0 || K(2, 2) != 1)
     fail("K", "expected an upper-triangular intrinsic matrix with last row (0, 0, 1), got " +

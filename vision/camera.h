@@ -15,6 +15,11 @@
 
 namespace subflow::vision {
 
+// The largest image side a camera may have (px): beyond any sensor, and small enough that
+// the per-pixel buffers of a camera (images, z-buffers, silhouettes) can be allocated.
+// Readers refuse larger sizes before allocating anything for them.
+inline constexpr int kMaxImageSide = 1 << 15;
+
 class Camera {
  public:
   Camera() = default;

@@ -33,6 +33,9 @@
 namespace subflow::vision {
 
 inline constexpr const char* kDatasetFormat = "multiview-video/1";
+// The most frames a dataset may have (frame_count, a video's reported count): ~9 hours at
+// 30 fps. Larger counts are refused before anything per frame is allocated.
+inline constexpr int kMaxFrameCount = 1000000;
 
 struct DatasetOptions {
   // Decoded images held in memory, counted in frames: at most cache_frames × camera_count
