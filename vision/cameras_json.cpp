@@ -192,7 +192,7 @@ std::vector<Camera> ReadCamerasJson(const std::string& path, DatasetInfo* info) 
     where += " (\"" + name + "\")";
     if (!names.insert(name).second)
       reader.Fail(where + ".name", "expected unique camera names, \"" + name + "\" appears twice");
-    reader.OnlyKeys(entry, {"name", "width", "height", "K", "R", "t", "distortion"}, where);
+    reader.OnlyKeys(entry, {"name", "width", "height", "K", "R", "t", "distortion", "distortion_model"}, where);
     const int width = reader.PositiveInt(reader.Required(entry, "width", where), where + ".width");
     const int height = reader.PositiveInt(reader.Required(entry, "height", where), where + ".height");
     const Eigen::Matrix3d K = reader.Matrix3(reader.Required(entry, "K", where), where + ".K");
@@ -201,7 +201,13 @@ std::vector<Camera> ReadCamerasJson(const std::string& path, DatasetInfo* info) 
     Eigen::VectorXd distortion;
     if (entry.contains("distortion"))
       distortion = reader.Vector(entry["distortion"], -1, where + ".distortion");
-    cameras.emplace_back(name, width, height, K, R, t, distortion, path);
+    DistortionModel model = DistortionModel::kOpenCV;
+    if (entry.contains("distortion_model")) {
+      const json& value = entry["distortion_model"];
+      if (!value.is_string() || !ParseDistortionModel(value.get<std::string>(), &model))
+        reader.Fail(where + ".distortion_model", "expected \"opencv\" or \"fisheye\", got " + value.dump());
+    }
+    cameras.emplace_back(name, width, height, K, R, t, distortion, path, model);
   }
   if (info) *info = parsed;
   return cameras;
@@ -243,6 +249,8 @@ void WriteCamerasJson(const std::string& path, const std::vector<Camera>& camera
     entry["R"] = MatrixJson(camera.R());
     entry["t"] = VectorJson(camera.t());
     entry["distortion"] = VectorJson(camera.distortion());
+    if (camera.distortion_model() != DistortionModel::kOpenCV)
+      entry["distortion_model"] = DistortionModelName(camera.distortion_model());
     list.push_back(entry);
   }
   root["cameras"] = list;
