@@ -12,6 +12,7 @@ packages=(
   libtet1.5-dev
   libtbb-dev
   libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
+  libpugixml-dev libtomlplusplus-dev  # calibration importers: Qualisys XML, Pose2Sim/Anipose TOML
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmesh-dev  # optional reference in bench/subdivision_bench
 )
