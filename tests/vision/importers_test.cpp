@@ -12,8 +12,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
-#include "vision/colmap_import.h"
-#include "vision/projection_matrix_import.h"
+#include "vision/import_colmap.h"
+#include "vision/import_projection_matrices.h"
 #include "tests/test_support.h"
 
 namespace subflow::vision {
