@@ -1,6 +1,7 @@
 #include "vision/calibration_preview.h"
 
 #include <cmath>
+#include <tuple>
 
 #include <opencv2/imgproc.hpp>
 
@@ -50,20 +51,16 @@ cv::Mat DrawCalibrationPreview(const Camera& camera, const cv::Mat& frame, const
     const double s = options.grid_spacing;
     const double u0 = std::floor(bounds.min[u] / s) * s, u1 = std::ceil(bounds.max[u] / s) * s;
     const double v0 = std::floor(bounds.min[v] / s) * s, v1 = std::ceil(bounds.max[v] / s) * s;
-    for (double a = u0; a <= u1 + 1e-9; a += s) {
-      Eigen::Vector3d p = Eigen::Vector3d::Zero(), q = Eigen::Vector3d::Zero();
-      p[u] = q[u] = a;
-      p[v] = v0;
-      q[v] = v1;
-      DrawSegment(camera, p, q, cv::Scalar(255, 255, 0), t, &image);
-    }
-    for (double b = v0; b <= v1 + 1e-9; b += s) {
-      Eigen::Vector3d p = Eigen::Vector3d::Zero(), q = Eigen::Vector3d::Zero();
-      p[v] = q[v] = b;
-      p[u] = u0;
-      q[u] = u1;
-      DrawSegment(camera, p, q, cv::Scalar(255, 255, 0), t, &image);
-    }
+    // Lines of constant u across [v0, v1], then of constant v across [u0, u1].
+    for (const auto& [along, across, from, to, lo, hi] :
+         {std::tuple{u, v, u0, u1, v0, v1}, std::tuple{v, u, v0, v1, u0, u1}})
+      for (double a = from; a <= to + 1e-9; a += s) {
+        Eigen::Vector3d p = Eigen::Vector3d::Zero(), q = Eigen::Vector3d::Zero();
+        p[along] = q[along] = a;
+        p[across] = lo;
+        q[across] = hi;
+        DrawSegment(camera, p, q, cv::Scalar(255, 255, 0), t, &image);
+      }
   }
   for (int corner = 0; corner < 8; ++corner)
     for (int axis = 0; axis < 3; ++axis) {
