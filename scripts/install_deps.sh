@@ -13,6 +13,7 @@ packages=(
   libtbb-dev
   libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libtinygltf-dev
+  libpugixml-dev libtomlplusplus-dev  # calibration importers: Qualisys XML, Pose2Sim/Anipose TOML
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmesh-dev  # optional reference in bench/subdivision_bench
   # Tests of the exports and the viewer: Blender reads the point caches and the .glb

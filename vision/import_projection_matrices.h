@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "vision/calibration_import.h"
 #include "vision/camera.h"
 
 namespace subflow::vision {
@@ -42,5 +43,16 @@ std::vector<Camera> ReadProjectionMatrixFolder(const std::string& directory,
 // name = stem of imgname. Throws naming the file and line.
 std::vector<Camera> ReadMiddleburyParameters(const std::string& par_file,
                                              const ProjectionMatrixImportOptions& options = {});
+
+// The same as Calibrations for `subflow import` (formats "matrices" and "middlebury"):
+// sizes found as above, or left 0 (taken from the media) unless `require_sizes`.
+Calibration ReadProjectionMatrixCalibration(const std::string& directory,
+                                            const ProjectionMatrixImportOptions& options = {},
+                                            bool require_sizes = false);
+Calibration ReadMiddleburyCalibration(const std::string& par_file, const ProjectionMatrixImportOptions& options = {},
+                                      bool require_sizes = false);
+// K, R, t of P = λ K [R | t] (see CameraFromProjectionMatrix), size unknown.
+CalibratedCamera DecomposeProjectionMatrix(const Eigen::Matrix<double, 3, 4>& P, const std::string& name,
+                                           const std::string& source);
 
 }  // namespace subflow::vision
