@@ -22,6 +22,7 @@
 #include "vision/calibration_preview.h"
 #include "vision/dataset.h"
 #include "vision/dataset_import.h"
+#include "vision/dataset_writer.h"
 #include "vision/read_calibration.h"
 
 namespace subflow::cli {
@@ -111,6 +112,7 @@ void RunImport(ImportArguments arguments) {
   }
   if (arguments.frames > 0) options.frames = arguments.frames;
   options.Check();
+  vision::CheckDatasetDirectory(arguments.out, options.overwrite);  // before any work
   const vision::Calibration calibration = vision::ReadCalibration(arguments.format, arguments.source, arguments.read);
   ProgressBar progress;
   const vision::DatasetImportResult result = vision::ImportDataset(calibration, arguments.out, options, &progress);

@@ -38,15 +38,21 @@ void WritePng(const fs::path& path, const cv::Mat& image) {
 
 }  // namespace
 
+void CheckDatasetDirectory(const std::string& directory, bool overwrite) {
+  const fs::path root(directory);
+  if (!fs::exists(root)) return;
+  if (!fs::is_directory(root))
+    ThrowError(directory, "", "exists and is not a directory (expected a new dataset directory)");
+  if (!fs::is_empty(root) && !overwrite)
+    ThrowError(directory, "", "exists and is not empty; refusing to overwrite it (choose another directory or pass "
+                               "--overwrite to replace the dataset in it)");
+}
+
 void PrepareDatasetDirectory(const std::string& directory, bool overwrite) {
+  CheckDatasetDirectory(directory, overwrite);
   const fs::path root(directory);
   if (fs::exists(root)) {
-    if (!fs::is_directory(root))
-      ThrowError(directory, "", "exists and is not a directory (expected a new dataset directory)");
     if (!fs::is_empty(root)) {
-      if (!overwrite)
-        ThrowError(directory, "", "exists and is not empty; refusing to overwrite it (choose another directory or pass "
-                                   "--overwrite to replace the dataset in it)");
       for (const char* entry : kDatasetEntries) {
         std::error_code error;
         fs::remove_all(root / entry, error);

@@ -30,6 +30,11 @@ void WriteCamerasJson(const std::string& path, const std::vector<Camera>& camera
 // removed, nothing else.
 void PrepareDatasetDirectory(const std::string& directory, bool overwrite);
 
+// Throws, as PrepareDatasetDirectory would, when `directory` is not a directory or is a
+// non-empty one and `overwrite` is false; changes nothing. For commands that check their
+// output before doing any work.
+void CheckDatasetDirectory(const std::string& directory, bool overwrite);
+
 // Creates a dataset directory and fills it. The constructor writes cameras.json and
 // creates images/<cam>/; the Write* calls write one file each (PNG, lossless). It never
 // overwrites a non-empty existing directory unless `overwrite` is set (then the
