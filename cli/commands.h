@@ -25,6 +25,7 @@ Command AddSubdivideCommand(CLI::App& app);  // cli/subdivide_command.cpp
 Command AddHullCommand(CLI::App& app);       // cli/hull_command.cpp
 Command AddReconstructCommand(CLI::App& app);  // cli/reconstruct_command.cpp
 Command AddExportCommand(CLI::App& app);       // cli/export_command.cpp
+Command AddRenderCommand(CLI::App& app);       // cli/render_command.cpp
 
 inline std::vector<AddCommandFunction> AllCommands() {
   return {
@@ -35,6 +36,7 @@ inline std::vector<AddCommandFunction> AllCommands() {
       AddHullCommand,
       AddReconstructCommand,
       AddExportCommand,
+      AddRenderCommand,
   };
 }
 
