@@ -1,9 +1,13 @@
 #include "output/result_pictures.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <memory>
 #include <set>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "core/error.h"
@@ -85,118 +89,166 @@ nlohmann::json RenderSummary::Json() const {
   return json;
 }
 
+namespace {
+
+// One MP4 per camera, written under a temporary name and renamed when complete.
+class Mp4Writers {
+ public:
+  Mp4Writers(const std::string& out, double fps) : directory_(fs::path(out) / "mp4"), fps_(fps) {}
+
+  void Write(const std::string& camera, const cv::Mat& picture) {
+    cv::Mat even;  // codecs want even sizes
+    cv::copyMakeBorder(picture, even, 0, picture.rows % 2, 0, picture.cols % 2, cv::BORDER_REPLICATE);
+    cv::VideoWriter& video = videos_[camera];
+    if (!video.isOpened()) {
+      fs::create_directories(directory_);
+      const fs::path partial = directory_ / (camera + ".partial.mp4");
+      video.open(partial.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps_, even.size());
+      if (!video.isOpened()) ThrowError(partial.string(), "", "OpenCV cannot write MP4 (mp4v) on this system");
+    }
+    video.write(even);
+  }
+
+  // Closes and renames every video; adds them to `summary`.
+  void Finish(int first_frame, RenderSummary* summary) {
+    for (auto& [camera, video] : videos_) {
+      video.release();
+      fs::rename(directory_ / (camera + ".partial.mp4"), directory_ / (camera + ".mp4"));
+      summary->pictures.push_back({"mp4/" + camera + ".mp4", "mp4", first_frame, camera, 0, 0, {}, false});
+    }
+  }
+
+ private:
+  fs::path directory_;
+  double fps_;
+  std::map<std::string, cv::VideoWriter> videos_;
+};
+
+// What every picture of one frame shares.
+struct FrameScene {
+  const ResultFrame& frame;
+  const geometry::Faces& F;
+  geometry::Positions normals;
+  std::vector<Eigen::MatrixX3f> colours;  // per flow kind
+  std::string name;                       // six-digit frame name
+  bool selected;                          // picture it (else only the MP4)
+};
+
+class ResultPainter {
+ public:
+  ResultPainter(const vision::Dataset* dataset, const std::vector<std::string>& kinds,
+                const std::vector<ColourScale>& scales, const RenderOptions& options, const std::string& out,
+                double fps, RenderSummary* summary)
+      : dataset_(dataset), kinds_(kinds), scales_(scales), options_(options), writer_(out, summary), mp4_(out, fps) {}
+
+  // Flow pictures, overlays and the contact sheet from the dataset's cameras.
+  void CameraPictures(const FrameScene& scene) {
+    const std::vector<vision::ZBuffer> zbuffers = vision::RenderZBuffers(dataset_->cameras(), scene.frame.V, scene.F);
+    std::vector<cv::Mat> sheet;
+    std::vector<std::string> labels;
+    for (int c = 0; c < dataset_->camera_count(); ++c) {
+      const vision::ZBuffer& zbuffer = zbuffers[static_cast<std::size_t>(c)];
+      const std::string camera = dataset_->camera(c).name();
+      std::vector<cv::Mat> shaded;
+      for (std::size_t k = 0; k < kinds_.size(); ++k) {
+        shaded.push_back(ShadeVertexColours(zbuffer, scene.frame.V, scene.F, scene.normals, scene.colours[k], options_.shading));
+        if (scene.selected)
+          writer_.Write(kinds_[k] + "/" + camera + "/" + scene.name + ".png", shaded[k], zbuffer, kinds_[k],
+                        scene.frame.frame, camera, &scales_[k]);
+      }
+      if (!options_.overlays && !options_.mp4) continue;
+      const cv::Mat image = dataset_->camera(c).UndistortImage(ToBgr8(dataset_->Image(c, scene.frame.frame)));
+      const cv::Mat overlay = Overlay(image, shaded[0], zbuffer.Mask(), SurfaceOutline(zbuffer), options_.overlay);
+      if (scene.selected && options_.overlays) {
+        writer_.Write("overlay/" + camera + "/" + scene.name + ".png", overlay, zbuffer, "overlay", scene.frame.frame,
+                      camera, &scales_[0]);
+        sheet.push_back(overlay);
+        labels.push_back(camera + " " + scene.name);
+      }
+      if (options_.mp4) mp4_.Write(camera, WithColourBar(overlay, scales_[0]));
+    }
+    if (sheet.empty()) return;
+    const int columns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(sheet.size()))));
+    writer_.Write("contact_sheet/" + scene.name + ".png", ContactSheet(sheet, labels, columns, std::min(480, sheet[0].cols)),
+                  zbuffers.front(), "contact_sheet", scene.frame.frame, "all", nullptr);
+  }
+
+  // Flow pictures and textured pictures from new views around the object.
+  void TurntablePictures(const FrameScene& scene, const Eigen::Vector3d& up) {
+    std::unique_ptr<CameraTexture> texture;
+    if (dataset_ && options_.textured)
+      texture = std::make_unique<CameraTexture>(*dataset_, scene.frame.frame, scene.frame.V, scene.F);
+    ShadingOptions unlit = options_.shading;  // the images carry their own light
+    unlit.ambient = 1.0;
+    for (const vision::Camera& view : TurntableCameras(scene.frame.V, up, options_.turntable)) {
+      const vision::ZBuffer zbuffer(view, scene.frame.V, scene.F);
+      for (std::size_t k = 0; k < kinds_.size(); ++k)
+        writer_.Write("turntable/" + kinds_[k] + "_" + scene.name + "_" + view.name() + ".png",
+                      ShadeVertexColours(zbuffer, scene.frame.V, scene.F, scene.normals, scene.colours[k], options_.shading),
+                      zbuffer, kinds_[k], scene.frame.frame, view.name(), &scales_[k]);
+      if (!texture) continue;
+      const PixelColour colour = [&](int, int, const Eigen::Vector3d& X, const Eigen::Vector3d& n) {
+        Eigen::Vector3f rgb(0.6f, 0.6f, 0.6f);  // gray where no camera sees the point
+        texture->Colour(X, n, &rgb);
+        return rgb;
+      };
+      writer_.Write("textured/" + scene.name + "_" + view.name() + ".png",
+                    ShadePixelColours(zbuffer, scene.frame.V, scene.F, scene.normals, colour, unlit), zbuffer, "textured",
+                    scene.frame.frame, view.name(), nullptr);
+    }
+  }
+
+  void Finish(int first_frame, RenderSummary* summary) { mp4_.Finish(first_frame, summary); }
+
+ private:
+  const vision::Dataset* dataset_;
+  const std::vector<std::string>& kinds_;
+  const std::vector<ColourScale>& scales_;
+  const RenderOptions& options_;
+  PictureWriter writer_;
+  Mp4Writers mp4_;
+};
+
+}  // namespace
+
 RenderSummary RenderResultPictures(const ResultReader& result, const vision::Dataset* dataset,
                                    const ResultMetadata& metadata, const std::string& out,
                                    const RenderOptions& options, Progress* progress) {
-  RenderSummary summary;
-  PictureWriter writer(out, &summary);
   if (dataset && dataset->frame_count() < result.first_frame() + result.frame_count())
     ThrowError(dataset->directory(), "frames", "the dataset has fewer frames than the result");
+  RenderSummary summary;
   std::vector<FlowKind> kinds = {FlowKind::kTotal};
   if (HasFlow(result, FlowKind::kNonRigid)) kinds.push_back(FlowKind::kNonRigid);
+  std::vector<std::string> kind_names;
   std::vector<ColourScale> scales;
   for (FlowKind kind : kinds) {
     const FlowRange range = SequenceFlowRange(result, kind);
-    ColourScale scale{range.min, range.max, metadata.DisplayFactor(), FlowLabel(kind), metadata.DisplayUnit() + "/frame"};
-    scales.push_back(scale);
-    summary.scales[kind == FlowKind::kTotal ? "flow" : "nonrigid"] = scale;
+    kind_names.push_back(kind == FlowKind::kTotal ? "flow" : "nonrigid");
+    scales.push_back({range.min, range.max, metadata.DisplayFactor(), FlowLabel(kind), metadata.DisplayUnit() + "/frame"});
+    summary.scales[kind_names.back()] = scales.back();
   }
   const std::vector<int> frames = SelectedFrames(result, options.frames);
   const int turntable_frame = options.turntable_frame >= 0 ? options.turntable_frame
                                                            : result.first_frame() + (result.frame_count() - 1) / 2;
   SelectedFrames(result, {turntable_frame});
   const Eigen::Vector3d up = dataset ? CamerasUp(dataset->cameras()) : Eigen::Vector3d::UnitZ();
-  const bool images = dataset && (options.overlays || options.textured || options.mp4);
-  std::map<int, cv::VideoWriter> videos;
-  std::map<int, fs::path> video_paths;
+  ResultPainter painter(dataset, kind_names, scales, options, out, metadata.fps, &summary);
 
   ProgressBegin(progress, "pictures", static_cast<std::size_t>(result.frame_count()));
   ForEachFrameFlow(result, kinds, [&](const ResultFrame& frame, const std::vector<Eigen::VectorXf>& magnitudes) {
     const bool selected = std::find(frames.begin(), frames.end(), frame.frame) != frames.end();
     const bool turntable = frame.frame == turntable_frame && options.turntable.count > 0;
+    if (selected || turntable || (options.mp4 && dataset)) {
+      FrameScene scene{frame, result.faces(), geometry::VertexNormals(frame.V, result.faces()), {},
+                       vision::FrameName(frame.frame), selected};
+      for (std::size_t k = 0; k < kinds.size(); ++k) scene.colours.push_back(VertexColours(magnitudes[k], scales[k]));
+      if (dataset) painter.CameraPictures(scene);
+      if (turntable) painter.TurntablePictures(scene, up);
+    }
     ProgressUpdate(progress, static_cast<std::size_t>(frame.frame - result.first_frame() + 1));
-    if (!selected && !turntable && !options.mp4) return;
-    const geometry::Faces& F = result.faces();
-    const geometry::Positions normals = geometry::VertexNormals(frame.V, F);
-    const std::string name = vision::FrameName(frame.frame);
-    std::vector<Eigen::MatrixX3f> colours;
-    for (std::size_t k = 0; k < kinds.size(); ++k) colours.push_back(VertexColours(magnitudes[k], scales[k]));
-
-    if (dataset) {
-      const std::vector<vision::ZBuffer> zbuffers = vision::RenderZBuffers(dataset->cameras(), frame.V, F);
-      std::vector<cv::Mat> sheet;
-      std::vector<std::string> labels;
-      for (int c = 0; c < dataset->camera_count(); ++c) {
-        const vision::ZBuffer& zbuffer = zbuffers[static_cast<std::size_t>(c)];
-        const std::string camera = dataset->camera(c).name();
-        std::vector<cv::Mat> shaded;
-        for (std::size_t k = 0; k < kinds.size(); ++k) {
-          shaded.push_back(ShadeVertexColours(zbuffer, frame.V, F, normals, colours[k], options.shading));
-          const std::string kind = k == 0 ? "flow" : "nonrigid";
-          if (selected) writer.Write(kind + "/" + camera + "/" + name + ".png", shaded[k], zbuffer, kind, frame.frame, camera, &scales[k]);
-        }
-        if (!images || !(options.overlays || options.mp4)) continue;
-        const cv::Mat image = dataset->camera(c).UndistortImage(ToBgr8(dataset->Image(c, frame.frame)));
-        const cv::Mat overlay = Overlay(image, shaded[0], zbuffer.Mask(), SurfaceOutline(zbuffer), options.overlay);
-        if (selected && options.overlays) {
-          writer.Write("overlay/" + camera + "/" + name + ".png", overlay, zbuffer, "overlay", frame.frame, camera, &scales[0]);
-          sheet.push_back(overlay);
-          labels.push_back(camera + " " + name);
-        }
-        if (options.mp4) {
-          const cv::Mat picture = WithColourBar(overlay, scales[0]);
-          cv::Mat even;  // codecs want even sizes
-          cv::copyMakeBorder(picture, even, 0, picture.rows % 2, 0, picture.cols % 2, cv::BORDER_REPLICATE);
-          if (!videos.count(c)) {
-            video_paths[c] = fs::path(out) / "mp4" / (camera + ".partial.mp4");
-            fs::create_directories(video_paths[c].parent_path());
-            videos[c].open(video_paths[c].string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), metadata.fps, even.size());
-            if (!videos[c].isOpened())
-              ThrowError(video_paths[c].string(), "", "OpenCV cannot write MP4 (mp4v) on this system");
-          }
-          videos[c].write(even);
-        }
-      }
-      if (!sheet.empty()) {
-        const vision::ZBuffer& zbuffer = zbuffers.front();
-        const int columns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(sheet.size()))));
-        writer.Write("contact_sheet/" + name + ".png", ContactSheet(sheet, labels, columns, std::min(480, sheet[0].cols)),
-                     zbuffer, "contact_sheet", frame.frame, "all", nullptr);
-      }
-    }
-    if (!turntable) return;
-    const std::vector<vision::Camera> views = TurntableCameras(frame.V, up, options.turntable);
-    std::unique_ptr<CameraTexture> texture;
-    if (images && options.textured) texture = std::make_unique<CameraTexture>(*dataset, frame.frame, frame.V, F);
-    for (const vision::Camera& view : views) {
-      const vision::ZBuffer zbuffer(view, frame.V, F);
-      for (std::size_t k = 0; k < kinds.size(); ++k) {
-        const std::string kind = k == 0 ? "flow" : "nonrigid";
-        writer.Write("turntable/" + kind + "_" + name + "_" + view.name() + ".png",
-                     ShadeVertexColours(zbuffer, frame.V, F, normals, colours[k], options.shading), zbuffer, kind,
-                     frame.frame, view.name(), &scales[k]);
-      }
-      if (!texture) continue;
-      const cv::Mat textured = ShadePixelColours(
-          zbuffer, frame.V, F, normals,
-          [&](int, int, const Eigen::Vector3d& X, const Eigen::Vector3d& n) {
-            Eigen::Vector3f rgb(0.6f, 0.6f, 0.6f);  // gray where no camera sees the point
-            texture->Colour(X, n, &rgb);
-            return rgb;
-          },
-          [&] { ShadingOptions flat = options.shading; flat.ambient = 1.0; return flat; }());
-      writer.Write("textured/" + name + "_" + view.name() + ".png", textured, zbuffer, "textured", frame.frame,
-                   view.name(), nullptr);
-    }
   });
   ProgressEnd(progress);
-  for (auto& [c, video] : videos) {
-    video.release();
-    const fs::path final_path = fs::path(out) / "mp4" / (dataset->camera(c).name() + ".mp4");
-    fs::rename(video_paths[c], final_path);
-    summary.pictures.push_back({fs::relative(final_path, out).string(), "mp4", result.first_frame(),
-                                dataset->camera(c).name(), 0, 0, {}, false});
-  }
+  painter.Finish(result.first_frame(), &summary);
   return summary;
 }
 

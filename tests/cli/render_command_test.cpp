@@ -209,6 +209,20 @@ TEST(RenderCommand, Mp4HoldsEveryFrameOfEachCamera) {
   EXPECT_EQ(frames, 3);
 }
 
+TEST(RenderCommand, WithoutDatasetDrawsTheTurntableOnly) {
+  const fs::path out = Scratch().FreshPath("no_dataset");
+  const test::CommandResult run =
+      RunSubflow("render " + Quote(Result()) + " --no-dataset --views 3 --out " + Quote(out), Scratch().path());
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  const nlohmann::json report = nlohmann::json::parse(test::ReadTextFile(out / "report.json"));
+  ASSERT_EQ(report["pictures"].size(), 3u);
+  for (const nlohmann::json& picture : report["pictures"]) {
+    EXPECT_EQ(picture["path"].get<std::string>().rfind("turntable/flow_000001_view", 0), 0u) << picture["path"];
+    EXPECT_GT(picture["surface_pixels"].get<int>(), 0);
+  }
+  EXPECT_FALSE(fs::exists(out / "overlay"));
+}
+
 TEST(RenderCommand, RefusesFramesOutsideTheResultAndExistingOutput) {
   const test::CommandResult bad = RunSubflow(
       "render " + Quote(Result()) + " --out " + Quote(Scratch().FreshPath("bad")) + " --frames 7", Scratch().path());
