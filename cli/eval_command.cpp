@@ -16,6 +16,7 @@
 #include "cli/progress_bar.h"
 #include "core/error.h"
 #include "geometry/mesh_io.h"
+#include "output/overwrite_guard.h"
 #include "solver/rigid_motion.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
@@ -25,7 +26,9 @@ namespace {
 
 struct EvalSettings {
   std::string dataset, result, json_path;
+  bool overwrite = false;
   vision::EvaluationOptions options;
+  bool hull = false;  // score RESULT/hull/ (visual hulls) instead of RESULT/meshes/
 };
 
 Eigen::Matrix3d CayleyRotation(const Eigen::Vector3d& w) {
@@ -78,11 +81,14 @@ nlohmann::json RigidComparison(const std::string& dataset_directory, const std::
 }
 
 void RunEval(const EvalSettings& settings) {
+  if (!settings.json_path.empty()) output::CheckOutputFile(settings.json_path, settings.overwrite, "--json");
   ProgressBar progress;
   const vision::EvaluationReport report =
-      vision::EvaluateReconstruction(settings.dataset, settings.result, settings.options, &progress);
+      vision::EvaluateReconstruction(settings.dataset, settings.result, settings.options, &progress,
+                                     settings.hull ? "hull" : "meshes");
   std::cout << report.Table();
-  const nlohmann::json rigid = RigidComparison(settings.dataset, settings.result);
+  const nlohmann::json rigid =
+      settings.hull ? nlohmann::json::array() : RigidComparison(settings.dataset, settings.result);
   if (!rigid.empty()) {
     double worst = 0.0, sum = 0.0;
     for (const auto& step : rigid) {
@@ -114,15 +120,25 @@ Command AddEvalCommand(CLI::App& app) {
   auto settings = std::make_shared<EvalSettings>();
   CLI::App* command = app.add_subcommand(
       "eval", "Score a reconstruction against ground truth: accuracy, completeness, Chamfer, Hausdorff, "
-              "scene-flow end-point error");
+              "scene-flow end-point error, on the whole and on the observed surface (seen by --min-views cameras)");
   command->add_option("dataset", settings->dataset, "Dataset directory (with groundtruth/mesh/)")->required();
   command->add_option("result", settings->result, "Result directory (with meshes/)")->required();
-  command->add_option("--json", settings->json_path, "Also write the figures to this JSON file");
+  command->add_option("--json", settings->json_path,
+                      "Also write the figures to this JSON file (an existing file is refused without --overwrite)");
+  command->add_flag("--overwrite", settings->overwrite, "Replace the --json file if it exists");
   command->add_option("--threshold", settings->options.threshold,
                       "Completeness distance (world units); 0 = 1 % of the true bounding-box diagonal")
       ->capture_default_str();
   command->add_option("--samples", settings->options.samples, "Area-weighted samples per surface and frame")
       ->capture_default_str();
+  command->add_option("--min-views", settings->options.min_views,
+                      "Observed surface: true surface seen by at least this many cameras (z-buffer visibility)")
+      ->capture_default_str();
+  command->add_option("--visibility-tolerance", settings->options.visibility_tolerance,
+                      "Depth tolerance of the visibility test (world units); 0 = 0.25 % of the true bbox diagonal")
+      ->capture_default_str();
+  command->add_flag("--hull", settings->hull,
+                    "Score RESULT/hull/ (the visual hulls of `subflow hull`) instead of RESULT/meshes/: surfaces only");
   return {command, [settings] { RunEval(*settings); }};
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -49,14 +50,16 @@ void CheckPngHeader(const std::string& path, const Camera& camera) {
       !std::equal(header + 12, header + 16, reinterpret_cast<const unsigned char*>("IHDR")))
     ThrowError(path, "", "unreadable image: expected a PNG file (bad or truncated PNG header)");
   auto big_endian = [&](int offset) {
-    return (int(header[offset]) << 24) | (int(header[offset + 1]) << 16) |
-           (int(header[offset + 2]) << 8) | int(header[offset + 3]);
+    return (std::uint32_t{header[offset]} << 24) | (std::uint32_t{header[offset + 1]} << 16) |
+           (std::uint32_t{header[offset + 2]} << 8) | std::uint32_t{header[offset + 3]};
   };
-  const int width = big_endian(16), height = big_endian(20);
-  if (width != camera.width() || height != camera.height())
+  const std::uint32_t width = big_endian(16), height = big_endian(20);
+  if (width != static_cast<std::uint32_t>(camera.width()) ||
+      height != static_cast<std::uint32_t>(camera.height()))
     ThrowError(path, "size",
                "expected " + SizeText(camera.width(), camera.height()) + " (camera \"" +
-                   camera.name() + "\" in cameras.json), got " + SizeText(width, height));
+                   camera.name() + "\" in cameras.json), got " + std::to_string(width) + "×" +
+                   std::to_string(height));
 }
 
 // The per-camera folders <root>/<camera>/ of <frame><extension> files (images/, masks/):
@@ -217,7 +220,13 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
         ThrowError(path, "size", "expected " + SizeText(cameras[c].width(), cameras[c].height()) +
                                      " (camera \"" + cameras[c].name() + "\" in cameras.json), got " +
                                      SizeText(width, height));
-      const int count = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_COUNT));
+      const double reported = capture.get(cv::CAP_PROP_FRAME_COUNT);
+      if (reported > kMaxFrameCount && !layout.info.frame_count)
+        ThrowError(path, "frame count",
+                   "the video reports " + std::to_string(reported) + " frames, more than " +
+                       std::to_string(kMaxFrameCount) + "; give \"frame_count\" in cameras.json");
+      // A count OpenCV cannot know comes as 0 or negative; beyond int it is no count.
+      const int count = reported >= 1 && reported <= kMaxFrameCount ? static_cast<int>(reported) : 0;
       if (layout.info.frame_count) {
         if (count > 0 && count < *layout.info.frame_count)
           ThrowError(path, "frame count", "expected at least frame_count = " +

@@ -47,8 +47,8 @@ DatasetWriter::DatasetWriter(const std::string& directory, std::vector<Camera> c
       ThrowError(directory_, "", "exists and is not a directory (expected a new dataset directory)");
     if (!fs::is_empty(root)) {
       if (!overwrite)
-        ThrowError(directory_, "", "exists and is not empty; refusing to overwrite (set overwrite to "
-                                   "replace the dataset in it)");
+        ThrowError(directory_, "", "exists and is not empty; refusing to overwrite it (choose another directory or pass "
+                                   "--overwrite to replace the dataset in it)");
       for (const char* entry : kDatasetEntries) {
         std::error_code error;
         fs::remove_all(root / entry, error);

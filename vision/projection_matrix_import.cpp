@@ -16,8 +16,6 @@ namespace subflow::vision {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr double kMiddleburyRotationTolerance = 1e-4;
-
 std::string LineField(int line) { return "line " + std::to_string(line); }
 
 std::string Trim(const std::string& text) {
@@ -180,12 +178,7 @@ std::vector<Camera> ReadMiddleburyParameters(const std::string& par_file,
     R << v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16], v[17];
     const Eigen::Vector3d t(v[18], v[19], v[20]);
     const std::string source = par_file + ": " + LineField(line);
-    // The files print R to limited precision: project to the nearest rotation when close.
-    if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < kMiddleburyRotationTolerance &&
-        std::abs(R.determinant() - 1) < kMiddleburyRotationTolerance) {
-      Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      R = svd.matrixU() * svd.matrixV().transpose();
-    }
+    // The files print R to limited precision: Camera takes the nearest rotation.
     const std::string name = fs::path(image_name).stem().string();
     int width = 0, height = 0;
     SizeFor(name, fs::path(par_file).parent_path(), options, source, &width, &height, image_name);

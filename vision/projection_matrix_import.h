@@ -37,8 +37,8 @@ std::vector<Camera> ReadProjectionMatrixFolder(const std::string& directory,
 
 // A Middlebury multi-view "*_par.txt": first line the camera count n, then n lines
 // "imgname k11 k12 k13 k21 k22 k23 k31 k32 k33 r11 r12 r13 r21 r22 r23 r31 r32 r33 t1 t2 t3"
-// (P = K [R | t] given as K, R, t; as the files print R to limited precision, an R within
-// 1e-4 of a rotation is projected to the nearest one, any other R is an error). Camera
+// (P = K [R | t] given as K, R, t; as the files print R to limited precision, Camera takes
+// the nearest rotation, vision/rotation.h). Camera
 // name = stem of imgname. Throws naming the file and line.
 std::vector<Camera> ReadMiddleburyParameters(const std::string& par_file,
                                              const ProjectionMatrixImportOptions& options = {});
