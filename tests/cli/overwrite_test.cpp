@@ -95,10 +95,20 @@ const std::map<std::string, const WritingCommand*>& Commands() {
   static const WritingCommand reconstruct{
       true, [](const fs::path& out) { return "reconstruct " + Quoted(TinyDataset()) + " --out " + Quoted(out) + HullOptions(); },
       false};
+  static const WritingCommand export_glb{
+      false, [](const fs::path& out) { return "export " + Quoted(TinyResult()) + " --format glb --out " + Quoted(out); },
+      true};
+  static const WritingCommand render{
+      true,
+      [](const fs::path& out) { return "render " + Quoted(TinyResult()) + " --no-dataset --views 1 --out " + Quoted(out); },
+      true};
+  static const WritingCommand view{
+      false, [](const fs::path& out) { return "view " + Quoted(TinyResult()) + " --no-texture --out " + Quoted(out); },
+      true};
   static const std::map<std::string, const WritingCommand*> commands = {
       {"check", nullptr},  // prints its figures (text or --json) on stdout only
       {"subdivide", &subdivide}, {"eval", &eval}, {"synth", &synth}, {"hull", &hull},
-      {"reconstruct", &reconstruct}};
+      {"reconstruct", &reconstruct}, {"export", &export_glb}, {"render", &render}, {"view", &view}};
   return commands;
 }
 
