@@ -26,6 +26,8 @@ Command AddHullCommand(CLI::App& app);       // cli/hull_command.cpp
 Command AddReconstructCommand(CLI::App& app);  // cli/reconstruct_command.cpp
 Command AddExportCommand(CLI::App& app);       // cli/export_command.cpp
 Command AddImportCommand(CLI::App& app);       // cli/import_command.cpp
+Command AddRenderCommand(CLI::App& app);       // cli/render_command.cpp
+Command AddViewCommand(CLI::App& app);         // cli/view_command.cpp
 
 inline std::vector<AddCommandFunction> AllCommands() {
   return {
@@ -37,6 +39,8 @@ inline std::vector<AddCommandFunction> AllCommands() {
       AddReconstructCommand,
       AddExportCommand,
       AddImportCommand,
+      AddRenderCommand,
+      AddViewCommand,
   };
 }
 

@@ -18,24 +18,30 @@ FlowKind ParseFlowKind(const std::string& name, const std::string& source) {
   ThrowError(source, "", "unknown flow \"" + name + "\" (expected flow or nonrigid)");
 }
 
-void ForEachFrameFlow(const ResultReader& result, FlowKind kind,
-                      const std::function<void(const ResultFrame&, const Eigen::VectorXf&)>& visit) {
-  Eigen::VectorXf previous;
-  const std::string prefix = FlowPropertyPrefix(kind);
+void ForEachFrameFlow(const ResultReader& result, const std::vector<FlowKind>& kinds,
+                      const std::function<void(const ResultFrame&, const std::vector<Eigen::VectorXf>&)>& visit) {
+  std::vector<Eigen::VectorXf> previous;
   for (int i = 0; i < result.frame_count(); ++i) {
     const ResultFrame frame = result.ReadFrame(i);
-    Eigen::VectorXf magnitudes = frame.Vectors(prefix, result.MeshPath(i)).rowwise().norm().cast<float>();
+    std::vector<Eigen::VectorXf> magnitudes;
+    for (FlowKind kind : kinds)
+      magnitudes.push_back(frame.Vectors(FlowPropertyPrefix(kind), result.MeshPath(i)).rowwise().norm().cast<float>());
     if (i + 1 == result.frame_count() && i > 0) magnitudes = previous;
     visit(frame, magnitudes);
     previous = std::move(magnitudes);
   }
 }
 
+bool HasFlow(const ResultReader& result, FlowKind kind) {
+  const ResultFrame first = result.ReadFrame(0);
+  return first.properties.values.count(FlowPropertyPrefix(kind) + "x") > 0;
+}
+
 FlowRange SequenceFlowRange(const ResultReader& result, FlowKind kind) {
   double low = std::numeric_limits<double>::infinity(), high = 0.0;
-  ForEachFrameFlow(result, kind, [&](const ResultFrame&, const Eigen::VectorXf& magnitudes) {
-    low = std::min(low, static_cast<double>(magnitudes.minCoeff()));
-    high = std::max(high, static_cast<double>(magnitudes.maxCoeff()));
+  ForEachFrameFlow(result, {kind}, [&](const ResultFrame&, const std::vector<Eigen::VectorXf>& magnitudes) {
+    low = std::min(low, static_cast<double>(magnitudes[0].minCoeff()));
+    high = std::max(high, static_cast<double>(magnitudes[0].maxCoeff()));
   });
   return {low, high};
 }

@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -26,10 +27,14 @@ std::string FlowLabel(FlowKind kind);
 // Parses "flow" / "nonrigid"; throws subflow::Error naming `source` otherwise.
 FlowKind ParseFlowKind(const std::string& name, const std::string& source);
 
-// Calls visit(frame, magnitudes) for every frame of `result` in order (#V magnitudes,
-// the last frame's from the previous frame, see above). Reads each frame once.
-void ForEachFrameFlow(const ResultReader& result, FlowKind kind,
-                      const std::function<void(const ResultFrame&, const Eigen::VectorXf&)>& visit);
+// Calls visit(frame, magnitudes) for every frame of `result` in order; magnitudes[k] has
+// the #V magnitudes of kinds[k] (the last frame's from the previous frame, see above).
+// Reads each frame once.
+void ForEachFrameFlow(const ResultReader& result, const std::vector<FlowKind>& kinds,
+                      const std::function<void(const ResultFrame&, const std::vector<Eigen::VectorXf>&)>& visit);
+
+// Whether the result's frames carry the properties of `kind` (looked up in the first frame).
+bool HasFlow(const ResultReader& result, FlowKind kind);
 
 // Smallest and largest magnitude over every vertex and frame.
 struct FlowRange {

@@ -223,10 +223,12 @@ GlbSummary WriteGlb(const ResultReader& result, const std::string& path, const G
   GlbSummary summary;
 
   ProgressBegin(progress, "glb", static_cast<std::size_t>(frame_count));
-  ForEachFrameFlow(result, options.colour_flow, [&](const ResultFrame& frame, const Eigen::VectorXf& magnitudes) {
+  // Without colours the flow is not read (a result may lack it).
+  const std::vector<FlowKind> kinds = options.colours ? std::vector<FlowKind>{options.colour_flow} : std::vector<FlowKind>{};
+  ForEachFrameFlow(result, kinds, [&](const ResultFrame& frame, const std::vector<Eigen::VectorXf>& magnitudes) {
     const bool first = frame.frame == result.first_frame();
     const Floats normals = options.normals ? UnitNormals(frame.V, result.faces()) : Floats();
-    const Floats colours = options.colours ? LinearColours(magnitudes, options.colour_scale) : Floats();
+    const Floats colours = options.colours ? LinearColours(magnitudes[0], options.colour_scale) : Floats();
     if (first) {
       base_positions = ToFloats(frame.V);
       primitive.attributes["POSITION"] = builder.AddVec3(base_positions, true);

@@ -107,6 +107,25 @@ TEST(ExportCommand, MddHoldsBigEndianTimesAndFrames) {
   ExpectFramesAt(bytes, 28, true);
 }
 
+TEST(ExportCommand, ObjAndPlySequencesKeepPositionsFacesAndProperties) {
+  for (const char* format : {"obj", "ply"}) {
+    const fs::path out = Scratch().FreshPath(std::string("sequence_") + format);
+    const test::CommandResult run =
+        RunSubflow("export " + Quote(Result()) + " --format " + format + " --out " + Quote(out), Scratch().path());
+    ASSERT_EQ(run.exit_code, 0) << run.output();
+    for (int f = 0; f < 5; ++f) {
+      geometry::VertexProperties properties;
+      const geometry::TriangleMesh mesh =
+          geometry::ReadMesh((out / (vision::FrameName(f) + "." + format)).string(), {}, &properties);
+      const geometry::TriangleMesh stored = geometry::ReadMesh((Result() / "meshes" / (vision::FrameName(f) + ".ply")).string());
+      EXPECT_EQ(mesh.V, stored.V) << format << " " << f;  // float values, exactly
+      EXPECT_EQ(mesh.F, stored.F) << format << " " << f;
+      if (std::string(format) == "ply") EXPECT_EQ(properties.values.count("nonrigid_vx"), 1u);
+    }
+    EXPECT_TRUE(fs::exists(out / "report.json"));
+  }
+}
+
 TEST(ExportCommand, RefusesToOverwriteAndNamesBadInput) {
   const fs::path out = Scratch() / "again.glb";
   ASSERT_EQ(RunSubflow("export " + Quote(Result()) + " --format glb --out " + Quote(out), Scratch().path()).exit_code, 0);
@@ -123,6 +142,20 @@ TEST(ExportCommand, RefusesToOverwriteAndNamesBadInput) {
   EXPECT_NE(not_result.err.find("not a subflow result folder"), std::string::npos) << not_result.output();
   EXPECT_FALSE(fs::exists(Scratch() / "x.glb"));
   EXPECT_FALSE(fs::exists(Scratch() / "x.glb.tmp"));
+
+  const test::CommandResult bad_up = RunSubflow(
+      "export " + Quote(Result()) + " --format glb --up +w --out " + Quote(Scratch() / "y.glb"), Scratch().path());
+  EXPECT_EQ(bad_up.exit_code, 1);
+  EXPECT_NE(bad_up.err.find("--up: expected +x, -x, +y, -y, +z or -z"), std::string::npos) << bad_up.output();
+  // A frame of another vertex count stops the export before anything is written.
+  const fs::path broken = Scratch() / "broken";
+  test::WriteTinyResult(broken);
+  geometry::WriteMesh((broken / "meshes" / "000003.ply").string(), geometry::MakeIcosphere(1, 0.1));
+  const test::CommandResult mixed =
+      RunSubflow("export " + Quote(broken) + " --format pc2 --out " + Quote(Scratch() / "z.pc2"), Scratch().path());
+  EXPECT_EQ(mixed.exit_code, 1);
+  EXPECT_NE(mixed.err.find("000003.ply"), std::string::npos) << mixed.output();
+  EXPECT_FALSE(fs::exists(Scratch() / "z.pc2"));
 }
 
 // Runs the Khronos validator (viewer/tools/validate_gltf.mjs); the report as JSON.

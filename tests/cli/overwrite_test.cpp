@@ -106,10 +106,18 @@ const std::map<std::string, const WritingCommand*>& Commands() {
                Quoted(take / "videos") + " --out " + Quoted(out);
       },
       true};
+  static const WritingCommand render{
+      true,
+      [](const fs::path& out) { return "render " + Quoted(TinyResult()) + " --no-dataset --views 1 --out " + Quoted(out); },
+      true};
+  static const WritingCommand view{
+      false, [](const fs::path& out) { return "view " + Quoted(TinyResult()) + " --no-texture --out " + Quoted(out); },
+      true};
   static const std::map<std::string, const WritingCommand*> commands = {
       {"check", nullptr},  // prints its figures (text or --json) on stdout only
       {"subdivide", &subdivide}, {"eval", &eval}, {"synth", &synth}, {"hull", &hull},
-      {"reconstruct", &reconstruct}, {"export", &export_glb}, {"import", &import_qualisys}};
+      {"reconstruct", &reconstruct}, {"export", &export_glb}, {"import", &import_qualisys}, {"render", &render},
+      {"view", &view}};
   return commands;
 }
 

@@ -21,6 +21,7 @@ struct TinyResultOptions {
   int subdivisions = 2;           // 162 vertices, 320 faces
   double fps = 25.0;              // recorded as report.json's dataset.fps; ≤ 0: absent
   bool static_half = false;       // vertices with z < 0 never move (sparse morph targets)
+  Eigen::RowVector3d translation{0.0013, -0.0007, 0.0004};  // per frame (metres)
 };
 
 // Positions of frame f of the tiny result.
@@ -31,7 +32,7 @@ inline geometry::Positions TinyResultPositions(const geometry::TriangleMesh& sph
     if (options.static_half && sphere.V(v, 2) < 0.0) continue;
     const Eigen::RowVector3d rest = sphere.V.row(v);
     const double wave = 0.01 * std::sin(12.0 * rest.x() + 0.7 * f);
-    V.row(v) = rest * (1.0 + wave) + f * Eigen::RowVector3d(0.0013, -0.0007, 0.0004);
+    V.row(v) = rest * (1.0 + wave) + f * options.translation;
   }
   return V;
 }
@@ -46,7 +47,7 @@ inline void WriteTinyResult(const std::filesystem::path& directory, const TinyRe
     // Non-rigid part: the motion minus the translation (the wave's share).
     const Eigen::RowVector3d translation = options.static_half || f + 1 == options.frames
                                                ? Eigen::RowVector3d::Zero()
-                                               : Eigen::RowVector3d(0.0013, -0.0007, 0.0004);
+                                               : options.translation;
     const geometry::Positions motion =
         f + 1 < options.frames ? geometry::Positions(positions[f + 1] - positions[f])
                                : geometry::Positions(geometry::Positions::Zero(sphere.V.rows(), 3));
