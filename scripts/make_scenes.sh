@@ -29,7 +29,10 @@ scene pair_dome    pair    --rig dome --cameras 10 --environment room --frames 2
 # Twisting animal-like critter, ring of 10, textured room and shadows; with masks (for the
 # exact-mask hull) and the same images without masks (reconstructed from the background image).
 scene critter_ring critter --rig ring --cameras 10 --environment room --shadows --frames 24
-scene critter_nomasks critter --rig ring --cameras 10 --environment room --shadows --frames 24 --no-masks
+if [ ${#ONLY[@]} -eq 0 ] || [[ " ${ONLY[*]} " == *" critter_nomasks "* ]]; then
+  echo "== critter_nomasks: critter_ring without masks/ (hard links)"
+  rm -rf "$OUT/critter_nomasks" && cp -al "$OUT/critter_ring" "$OUT/critter_nomasks" && rm -rf "$OUT/critter_nomasks/masks"
+fi
 # Stills (one frame) of the bust's frame 30: with masks, and without masks or background.
 scene bust_still   bust    --rig front --cameras 11 --environment room --shadows --frames 1 --start-frame 30
 scene bust_still_bare bust --rig front --cameras 11 --environment room --shadows --frames 1 --start-frame 30 \
