@@ -13,13 +13,13 @@ RUNS=${2:-/work/scenes/runs}
 SUBFLOW=${3:-build/cli/subflow}
 shift $(( $# > 3 ? 3 : $# )) || true
 LIST=("$@")
-[ ${#LIST[@]} -gt 0 ] || LIST=(bust_front mug_ring pair_dome critter_nomasks bust_still bust_still_bare take_hd)
+[ ${#LIST[@]} -gt 0 ] || LIST=(bust_front mug_ring pair_dome critter_nomasks bust_still bust_still_bare take_small)
 
 mask_scene() {  # the dataset with the same images and masks
   case $1 in
     critter_nomasks) echo critter_ring ;;
     bust_still_bare) echo bust_still ;;
-    take_hd) echo "" ;;
+    take_small|take_hd) echo "" ;;
     *) echo "$1" ;;
   esac
 }
