@@ -44,6 +44,13 @@ scene bust_still_bare bust --rig front --cameras 11 --environment room --shadows
 TAKE=(pair --rig ring --cameras 4 --distortion -0.12,0.03,0,0,0 --environment room --distractors both
       --video mp4 --no-masks --no-background)
 scene take_small   "${TAKE[@]}" --width 272 --height 480 --frames 24
-if [[ " ${ONLY[*]} " == *" take_hd "* ]]; then  # only when asked for by name
+# On request only (by name): the full-size take, and two long small takes for the memory
+# floor of issue 13 (a 1,000-frame take within 1.3x the memory of a 100-frame one).
+if [[ " ${ONLY[*]} " == *" take_hd "* ]]; then
   scene take_hd    "${TAKE[@]}" --width 1088 --height 1920 --supersample 2 --frames 100
 fi
+for frames in 100 1000; do
+  if [[ " ${ONLY[*]} " == *" take_$frames "* ]]; then
+    scene "take_$frames" "${TAKE[@]}" --width 160 --height 288 --supersample 2 --frames "$frames"
+  fi
+done
