@@ -16,6 +16,7 @@
 #include "cli/progress_bar.h"
 #include "core/error.h"
 #include "geometry/mesh_io.h"
+#include "output/overwrite_guard.h"
 #include "solver/rigid_motion.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
@@ -25,6 +26,7 @@ namespace {
 
 struct EvalSettings {
   std::string dataset, result, json_path;
+  bool overwrite = false;
   vision::EvaluationOptions options;
   bool hull = false;  // score RESULT/hull/ (visual hulls) instead of RESULT/meshes/
 };
@@ -79,6 +81,7 @@ nlohmann::json RigidComparison(const std::string& dataset_directory, const std::
 }
 
 void RunEval(const EvalSettings& settings) {
+  if (!settings.json_path.empty()) output::CheckOutputFile(settings.json_path, settings.overwrite, "--json");
   ProgressBar progress;
   const vision::EvaluationReport report =
       vision::EvaluateReconstruction(settings.dataset, settings.result, settings.options, &progress,
@@ -120,7 +123,9 @@ Command AddEvalCommand(CLI::App& app) {
               "scene-flow end-point error, on the whole and on the observed surface (seen by --min-views cameras)");
   command->add_option("dataset", settings->dataset, "Dataset directory (with groundtruth/mesh/)")->required();
   command->add_option("result", settings->result, "Result directory (with meshes/)")->required();
-  command->add_option("--json", settings->json_path, "Also write the figures to this JSON file");
+  command->add_option("--json", settings->json_path,
+                      "Also write the figures to this JSON file (an existing file is refused without --overwrite)");
+  command->add_flag("--overwrite", settings->overwrite, "Replace the --json file if it exists");
   command->add_option("--threshold", settings->options.threshold,
                       "Completeness distance (world units); 0 = 1 % of the true bounding-box diagonal")
       ->capture_default_str();

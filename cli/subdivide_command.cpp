@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/mesh_io.h"
+#include "output/overwrite_guard.h"
 
 namespace subflow::cli {
 namespace {
@@ -19,10 +20,12 @@ struct SubdivideSettings {
   std::string output_path;
   int levels = 1;
   bool limit = false;
+  bool overwrite = false;
 };
 
 void RunSubdivide(const SubdivideSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
+  output::CheckOutputFile(settings.output_path, settings.overwrite, "--out");
   const geometry::TriangleMesh base = geometry::ReadMesh(settings.input_path);
   const geometry::LoopHierarchy hierarchy(base.F, base.vertex_count(), settings.levels,
                                           settings.input_path);
@@ -62,8 +65,10 @@ Command AddSubdivideCommand(CLI::App& app) {
   command->add_flag("--limit", settings->limit,
                     "Move the final vertices onto the limit surface (Loop's limit masks) "
                     "instead of writing the control points");
-  command->add_option("--out,-o", settings->output_path, "Output mesh (.ply or .obj)")
+  command->add_option("--out,-o", settings->output_path,
+                      "Output mesh (.ply or .obj); an existing file is refused without --overwrite")
       ->required();
+  command->add_flag("--overwrite", settings->overwrite, "Replace the output mesh if it exists");
   command->footer(
       "Vertex order: the input vertices keep their indices; each level appends one vertex "
       "per edge of the previous level.\nExample: subflow subdivide base.ply --levels 3 "

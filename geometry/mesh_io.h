@@ -1,7 +1,8 @@
 // Reading and writing triangle meshes: PLY (ascii, binary little/big endian) and OBJ.
 // Readers validate what they read and throw subflow::Error naming the file, the element
-// (line, vertex, face) and what was expected: non-triangle faces, indices out of range,
-// NaN/Inf coordinates, truncated data, unknown formats. Manifoldness is checked by
+// (line, vertex, face) and what was expected: faces of fewer than 3 corners, indices out
+// of range, NaN/Inf coordinates, truncated data, unknown formats. Polygon faces are
+// triangulated with a warning (geometry/polygon_triangulation.h). Manifoldness is checked by
 // MeshTopology (ReadMesh does it when `require_manifold` is set).
 // Writers never leave a half-written file: they write to "<path>.tmp" and rename.
 #pragma once
@@ -29,7 +30,7 @@ struct MeshReadOptions {
 };
 
 // Reads .ply or .obj (by extension, case-insensitive). Polygons with more than three
-// vertices are an error (subflow works on triangle meshes only).
+// vertices are triangulated (subflow works on triangle meshes), with a warning.
 TriangleMesh ReadMesh(const std::string& path, const MeshReadOptions& options = {},
                       VertexProperties* properties = nullptr);
 

@@ -1,21 +1,24 @@
 #include "geometry/obj_io.h"
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string_view>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "core/error.h"
+#include "geometry/polygon_triangulation.h"
 #include "geometry/text_parsing.h"
 
 namespace subflow::geometry {
 
 TriangleMesh ParseObj(const std::string& text, const std::string& source) {
   std::vector<double> positions;
+  PolygonFaces faces;
+  std::vector<int> face_lines;  // line of each face, for index errors found at the end
   std::vector<int> corners;
-  std::vector<int> corner_lines;  // line of each face, for index errors found at the end
   size_t pos = 0;
   int line_number = 0;
   while (pos < text.size()) {
@@ -34,6 +37,8 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
       if (tokens.size() < 4)
         ThrowError(source, where + " (vertex " + std::to_string(vertex) + ")",
                    "expected \"v x y z\"");
+      if (vertex == std::numeric_limits<int>::max())
+        ThrowError(source, where, "more than 2^31 − 1 vertices");
       for (int axis = 0; axis < 3; ++axis) {
         double value = 0.0;
         if (!ParseDouble(tokens[1 + axis], &value))
@@ -46,18 +51,22 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
         positions.push_back(value);
       }
     } else if (tokens[0] == "f") {
-      const int face = static_cast<int>(corner_lines.size());
+      const int face = faces.face_count();
       const std::string field = where + " (face " + std::to_string(face) + ")";
-      if (tokens.size() != 4)
+      const int count = static_cast<int>(tokens.size()) - 1;
+      if (count < 3)
         ThrowError(source, field,
-                   "has " + std::to_string(tokens.size() - 1) +
-                       " vertices; expected 3 (subflow reads triangle meshes only)");
+                   "has " + std::to_string(count) + " vertices; expected a polygon of at least 3");
+      if (count > kMaxPolygonCorners)
+        ThrowError(source, field,
+                   "has " + std::to_string(count) + " vertices; expected at most " +
+                       std::to_string(kMaxPolygonCorners));
       const int vertex_count = static_cast<int>(positions.size() / 3);
-      for (int k = 1; k <= 3; ++k) {
+      corners.clear();
+      for (int k = 1; k <= count; ++k) {
         const std::string_view corner = tokens[k].substr(0, tokens[k].find('/'));
         long long index = 0;
-        const auto result = std::from_chars(corner.data(), corner.data() + corner.size(), index);
-        if (result.ec != std::errc() || result.ptr != corner.data() + corner.size() || index == 0)
+        if (!ParseInteger(corner, &index) || index == 0)
           ThrowError(source, field,
                      "\"" + std::string(tokens[k]) +
                          "\" is not a vertex index (expected a non-zero integer)");
@@ -69,11 +78,12 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
                      "relative vertex index " + std::to_string(index) +
                          " points before the first vertex (only " + std::to_string(vertex_count) +
                          " vertices defined so far)");
-        if (zero_based > std::numeric_limits<int>::max())
+        if (zero_based >= std::numeric_limits<int>::max())
           ThrowError(source, field, "vertex index " + std::to_string(index) + " out of range");
         corners.push_back(static_cast<int>(zero_based));
       }
-      corner_lines.push_back(line_number);
+      faces.Add(corners.data(), count);
+      face_lines.push_back(line_number);
     }
     // Everything else (vt, vn, vp, l, p, o, g, s, usemtl, mtllib, ...) carries no
     // geometry subflow uses.
@@ -81,21 +91,22 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
 
   TriangleMesh mesh;
   const int n = static_cast<int>(positions.size() / 3);
-  const int m = static_cast<int>(corner_lines.size());
+  const int m = faces.face_count();
   if (n == 0) ThrowError(source, "vertices", "no \"v\" statement (expected a non-empty mesh)");
-  if (m == 0) ThrowError(source, "faces", "no \"f\" statement (expected a triangle mesh)");
+  if (m == 0) ThrowError(source, "faces", "no \"f\" statement (expected a polygon mesh)");
   mesh.V = Eigen::Map<const Positions>(positions.data(), n, 3);
-  mesh.F.resize(m, 3);
   for (int f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int v = corners[3 * f + k];
-      if (v >= n)
+    for (int c = faces.starts[f]; c < faces.starts[f + 1]; ++c)
+      if (faces.corners[c] >= n)
         ThrowError(source,
-                   "line " + std::to_string(corner_lines[f]) + " (face " + std::to_string(f) + ")",
-                   "vertex index " + std::to_string(v + 1) + " out of range [1, " +
+                   "line " + std::to_string(face_lines[f]) + " (face " + std::to_string(f) + ")",
+                   "vertex index " + std::to_string(faces.corners[c] + 1) + " out of range [1, " +
                        std::to_string(n) + "] (1-based)");
-      mesh.F(f, k) = v;
-    }
+  int polygons = 0;
+  mesh.F = TriangulatePolygons(faces, mesh.V, &polygons);
+  if (polygons > 0)
+    spdlog::warn("{}: {} of {} faces have more than 3 corners; triangulated into {} triangles",
+                 source, polygons, m, mesh.face_count());
   return mesh;
 }
 

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "core/error.h"
+#include "geometry/polygon_triangulation.h"
 #include "geometry/text_parsing.h"
 
 namespace subflow::geometry {
@@ -351,6 +352,18 @@ class BinaryBody {
   long long index_ = 0;
 };
 
+// The fewest bytes one instance of `element` can take: binary, the sum of its scalar sizes
+// and list-count sizes (a list may be empty); ascii, one character per value and one
+// separator between values and at the end of the line.
+long long SmallestInstanceBytes(const Element& element, Encoding encoding) {
+  long long bytes = 0;
+  for (const Property& property : element.properties)
+    bytes += encoding == Encoding::kAscii ? 2
+                                          : ScalarSize(property.is_list ? property.count_type
+                                                                        : property.type);
+  return bytes;
+}
+
 int FindProperty(const Element& element, std::initializer_list<const char*> names) {
   for (size_t p = 0; p < element.properties.size(); ++p)
     for (const char* name : names)
@@ -363,17 +376,22 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
                       const std::string& source, VertexProperties* properties) {
   const Element* vertex = nullptr;
   const Element* face = nullptr;
+  const long long data_bytes = static_cast<long long>(bytes.size() - header.body_offset);
   for (const Element& element : header.elements) {
     if (element.name == "vertex") vertex = &element;
     if (element.name == "face") face = &element;
-    // Every instance takes at least one byte, so a larger count cannot be honest; this
-    // rejects truncated files before allocating what their header promises.
-    if (!element.properties.empty() &&
-        element.count > static_cast<long long>(bytes.size() - header.body_offset))
+    // The data can hold at most data_bytes / (smallest size of an instance) instances, so a
+    // larger count cannot be honest: refuse it before allocating what the header promises.
+    const long long smallest = SmallestInstanceBytes(element, header.encoding);
+    if (smallest > 0 && element.count > data_bytes / smallest)
       ThrowError(source, "element " + element.name,
-                 "the header announces " + std::to_string(element.count) + " elements but only " +
-                     std::to_string(bytes.size() - header.body_offset) +
-                     " bytes of data follow (truncated file)");
+                 "the header announces " + std::to_string(element.count) + " elements of at least " +
+                     std::to_string(smallest) + " bytes but only " + std::to_string(data_bytes) +
+                     " bytes of data follow (truncated file?)");
+    if (smallest == 0 && element.count > 0)
+      ThrowError(source, "element " + element.name,
+                 "has " + std::to_string(element.count) +
+                     " instances but no property (expected properties to read)");
   }
   if (!vertex) ThrowError(source, "header", "no \"vertex\" element");
   if (!face) ThrowError(source, "header", "no \"face\" element (expected a triangle mesh)");
@@ -406,13 +424,17 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
 
   TriangleMesh mesh;
   mesh.V.resize(vertex->count, 3);
-  mesh.F.resize(face->count, 3);
+  PolygonFaces faces;
+  faces.corners.reserve(static_cast<size_t>(face->count) * 3);
+  faces.starts.reserve(static_cast<size_t>(face->count) + 1);
+  std::vector<int> corners;
   Eigen::MatrixXd extra(vertex->count, static_cast<Eigen::Index>(extra_names.size()));
   for (const Element& element : header.elements) {
     const bool is_vertex = &element == vertex;
     const bool is_face = &element == face;
     for (long long i = 0; i < element.count; ++i) {
       body.Begin(element, i);
+      bool have_corners = false;
       for (size_t p = 0; p < element.properties.size(); ++p) {
         const Property& property = element.properties[p];
         if (!property.is_list) {
@@ -429,24 +451,31 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
         if (length < 0)
           ThrowError(source, body.Where(), "negative list length in \"" + property.name + "\"");
         if (is_face && static_cast<int>(p) == index_property) {
-          if (length != 3)
+          if (length < 3 || length > kMaxPolygonCorners)
             ThrowError(source, body.Where(),
                        "has " + std::to_string(static_cast<long long>(length)) +
-                           " vertices; expected 3 (subflow reads triangle meshes only)");
-          for (int k = 0; k < 3; ++k) {
+                           " vertices; expected a polygon of 3 to " +
+                           std::to_string(kMaxPolygonCorners));
+          corners.clear();
+          for (int k = 0; k < static_cast<int>(length); ++k) {
             const double index = body.Scalar(property.type, property.name);
             if (index < 0 || index >= static_cast<double>(vertex->count))
               ThrowError(source, body.Where(),
                          "vertex index " + std::to_string(static_cast<long long>(index)) +
                              " out of range [0, " + std::to_string(vertex->count) + ")");
-            mesh.F(i, k) = static_cast<int>(index);
+            corners.push_back(static_cast<int>(index));
           }
+          faces.Add(corners.data(), static_cast<int>(corners.size()));
+          have_corners = true;
         } else {
+          // Every list item takes at least one byte (binary) or token (ascii): a length
+          // beyond the data left is caught by the reads themselves, item by item.
           for (long long k = 0; k < static_cast<long long>(length); ++k)
             body.Scalar(property.type, property.name);
         }
       }
       body.End();
+      SUBFLOW_CHECK(!is_face || have_corners, "face without corners");
       if (is_vertex) {
         for (int axis = 0; axis < 3; ++axis)
           if (!std::isfinite(mesh.V(i, axis)))
@@ -458,6 +487,11 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
     }
   }
   body.Finish();
+  int polygons = 0;
+  mesh.F = TriangulatePolygons(faces, mesh.V, &polygons);
+  if (polygons > 0)
+    spdlog::warn("{}: {} of {} faces have more than 3 corners; triangulated into {} triangles",
+                 source, polygons, face->count, mesh.face_count());
 
   if (properties) {
     properties->names = extra_names;

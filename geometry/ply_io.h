@@ -7,7 +7,8 @@
 // int32/uint32/float32/float64 aliases) for any property; the element "vertex" with
 // scalar properties x, y, z (others become VertexProperties, converted to double); the
 // element "face" with a list property "vertex_indices" (or "vertex_index") of any
-// integer count and index type, each list of length 3; any other element or property is
+// integer count and index type, each list of 3 or more indices (polygons are triangulated,
+// geometry/polygon_triangulation.h, with a warning); any other element or property is
 // skipped. An ascii element instance is one line.
 #pragma once
 
@@ -21,8 +22,9 @@ namespace subflow::geometry {
 
 // Parses the PLY document `bytes`; `source` (usually the path) names it in errors.
 // Throws subflow::Error on a bad header, an unsupported format, truncated data, fewer
-// lines than the header announces, non-triangle faces, indices out of range, NaN/Inf
-// coordinates. Does not check manifoldness.
+// lines than the header announces, element counts the data cannot hold (refused before
+// allocating), faces of fewer than 3 or more than kMaxPolygonCorners corners, indices out
+// of range, NaN/Inf coordinates. Does not check manifoldness.
 TriangleMesh ParsePly(const std::string& bytes, const std::string& source,
                       VertexProperties* properties = nullptr);
 

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/json_reader.h"
 #include "vision/dataset.h"
 #include "vision/dataset_writer.h"
 
@@ -19,90 +20,15 @@ namespace {
 
 using nlohmann::json;
 
-std::string TypeName(const json& value) { return value.type_name(); }
-
-// Line and column of a byte offset, for parse errors.
-std::string LineColumn(const std::string& text, std::size_t byte) {
-  int line = 1, column = 1;
-  for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+Eigen::Matrix3d Matrix3(const JsonReader& reader, const json& value, const std::string& field) {
+  const std::vector<double> m = reader.Matrix(value, 3, 3, field);
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.data());
 }
 
-class JsonReader {
- public:
-  explicit JsonReader(std::string path) : path_(std::move(path)) {}
-
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    ThrowError(path_, field, problem);
-  }
-
-  const json& Required(const json& object, const std::string& key, const std::string& where) const {
-    auto it = object.find(key);
-    if (it == object.end())
-      Fail(Join(where, key), "missing required field \"" + key + "\"");
-    return *it;
-  }
-
-  double Number(const json& value, const std::string& field) const {
-    if (!value.is_number()) Fail(field, "expected a number, got " + TypeName(value) + " " + value.dump());
-    const double x = value.get<double>();
-    if (!std::isfinite(x)) Fail(field, "expected a finite number, got " + value.dump());
-    return x;
-  }
-
-  int PositiveInt(const json& value, const std::string& field) const {
-    if (!value.is_number_integer() || value.get<long long>() <= 0 ||
-        value.get<long long>() > std::numeric_limits<int>::max())
-      Fail(field, "expected a positive integer, got " + value.dump());
-    return value.get<int>();
-  }
-
-  Eigen::VectorXd Vector(const json& value, int size, const std::string& field) const {
-    if (!value.is_array() || (size >= 0 && static_cast<int>(value.size()) != size))
-      Fail(field, "expected an array of " + (size >= 0 ? std::to_string(size) : std::string("")) +
-                      " numbers, got " + value.dump());
-    Eigen::VectorXd out(value.size());
-    for (std::size_t i = 0; i < value.size(); ++i)
-      out[i] = Number(value[i], field + "[" + std::to_string(i) + "]");
-    return out;
-  }
-
-  Eigen::Matrix3d Matrix3(const json& value, const std::string& field) const {
-    if (!value.is_array() || value.size() != 3)
-      Fail(field, "expected a 3×3 matrix as 3 rows of 3 numbers, got " + value.dump());
-    Eigen::Matrix3d out;
-    for (int r = 0; r < 3; ++r) {
-      if (!value[r].is_array() || value[r].size() != 3)
-        Fail(field, "expected a 3×3 matrix as 3 rows of 3 numbers, row " + std::to_string(r) +
-                        " is " + value[r].dump());
-      out.row(r) = Vector(value[r], 3, field + "[" + std::to_string(r) + "]").transpose();
-    }
-    return out;
-  }
-
-  void OnlyKeys(const json& object, const std::set<std::string>& allowed, const std::string& where) const {
-    for (auto it = object.begin(); it != object.end(); ++it)
-      if (!allowed.count(it.key())) {
-        std::string list;
-        for (const auto& key : allowed) list += (list.empty() ? "" : ", ") + key;
-        Fail(Join(where, it.key()), "unknown field (expected one of: " + list + ")");
-      }
-  }
-
-  static std::string Join(const std::string& where, const std::string& key) {
-    return where.empty() ? key : where + "." + key;
-  }
-
- private:
-  std::string path_;
-};
+Eigen::VectorXd Vector(const JsonReader& reader, const json& value, int size, const std::string& field) {
+  const std::vector<double> v = reader.Numbers(value, size, field);
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
 
 json MatrixJson(const Eigen::MatrixXd& m) {
   json rows = json::array();
@@ -130,78 +56,67 @@ void CheckCameraName(const std::string& name, const std::string& path, const std
 }  // namespace
 
 std::vector<Camera> ReadCamerasJson(const std::string& path, DatasetInfo* info) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file)
-    ThrowError(path, "", "cannot open (expected the dataset's cameras.json, format \"" +
-                             std::string(kDatasetFormat) + "\")");
-  std::stringstream buffer;
-  buffer << file.rdbuf();
-  const std::string text = buffer.str();
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::parse_error& e) {
-    ThrowError(path, "JSON syntax at " + LineColumn(text, e.byte),
-               std::string("expected valid JSON: ") + e.what());
-  }
+  const json root = ReadJsonFile(
+      path, "the dataset's cameras.json, format \"" + std::string(kDatasetFormat) + "\"");
   const JsonReader reader(path);
-  if (!root.is_object()) reader.Fail("(top level)", "expected a JSON object, got " + TypeName(root));
   reader.OnlyKeys(root, {"format", "fps", "frame_count", "units", "bounds", "cameras"}, "");
 
   const json& format = reader.Required(root, "format", "");
   if (!format.is_string() || format.get<std::string>() != kDatasetFormat)
-    reader.Fail("format", "expected \"" + std::string(kDatasetFormat) + "\", got " + format.dump());
+    reader.Fail("format", "expected \"" + std::string(kDatasetFormat) + "\", got " + ShowJson(format));
 
   DatasetInfo parsed;
-  if (root.contains("fps")) {
-    parsed.fps = reader.Number(root["fps"], "fps");
-    if (!(*parsed.fps > 0)) reader.Fail("fps", "expected a positive number, got " + root["fps"].dump());
+  if (const json* fps = reader.Optional(root, "fps", "")) {
+    parsed.fps = reader.Number(*fps, "fps");
+    if (!(*parsed.fps > 0)) reader.Fail("fps", "expected a positive number, got " + ShowJson(*fps));
   }
-  if (root.contains("frame_count")) parsed.frame_count = reader.PositiveInt(root["frame_count"], "frame_count");
-  if (root.contains("units")) {
-    if (!root["units"].is_string()) reader.Fail("units", "expected a string, got " + root["units"].dump());
-    parsed.units = root["units"].get<std::string>();
-  }
-  if (root.contains("bounds")) {
-    const json& bounds = root["bounds"];
-    if (!bounds.is_object())
-      reader.Fail("bounds", "expected {\"min\": [x, y, z], \"max\": [x, y, z]}, got " + bounds.dump());
-    reader.OnlyKeys(bounds, {"min", "max"}, "bounds");
+  if (const json* frame_count = reader.Optional(root, "frame_count", ""))
+    parsed.frame_count = static_cast<int>(reader.Integer(*frame_count, "frame_count", 1, kMaxFrameCount));
+  if (const json* units = reader.Optional(root, "units", "")) parsed.units = reader.String(*units, "units");
+  if (const json* bounds = reader.Optional(root, "bounds", "")) {
+    if (!bounds->is_object())
+      reader.Fail("bounds", "expected {\"min\": [x, y, z], \"max\": [x, y, z]}, got " + ShowJson(*bounds));
+    reader.OnlyKeys(*bounds, {"min", "max"}, "bounds");
     Bounds box;
-    box.min = reader.Vector(reader.Required(bounds, "min", "bounds"), 3, "bounds.min");
-    box.max = reader.Vector(reader.Required(bounds, "max", "bounds"), 3, "bounds.max");
+    box.min = Vector(reader, reader.Required(*bounds, "min", "bounds"), 3, "bounds.min");
+    box.max = Vector(reader, reader.Required(*bounds, "max", "bounds"), 3, "bounds.max");
     if (!(box.min.array() < box.max.array()).all())
-      reader.Fail("bounds", "expected min < max on every axis, got min " + bounds["min"].dump() +
-                                ", max " + bounds["max"].dump());
+      reader.Fail("bounds", "expected min < max on every axis, got min " + ShowJson((*bounds)["min"]) +
+                                ", max " + ShowJson((*bounds)["max"]));
     parsed.bounds = box;
   }
 
   const json& list = reader.Required(root, "cameras", "");
   if (!list.is_array() || list.empty())
-    reader.Fail("cameras", "expected a non-empty array of cameras, got " + list.dump());
+    reader.Fail("cameras", "expected a non-empty array of cameras, got " + ShowJson(list));
   std::vector<Camera> cameras;
   std::set<std::string> names;
   for (std::size_t i = 0; i < list.size(); ++i) {
     std::string where = "cameras[" + std::to_string(i) + "]";
     const json& entry = list[i];
-    if (!entry.is_object()) reader.Fail(where, "expected a camera object, got " + TypeName(entry));
-    const json& name_json = reader.Required(entry, "name", where);
-    if (!name_json.is_string()) reader.Fail(where + ".name", "expected a string, got " + name_json.dump());
-    const std::string name = name_json.get<std::string>();
+    reader.RequireObject(entry, where);
+    const std::string name = reader.String(reader.Required(entry, "name", where), where + ".name");
     CheckCameraName(name, path, where + ".name");
     where += " (\"" + name + "\")";
     if (!names.insert(name).second)
       reader.Fail(where + ".name", "expected unique camera names, \"" + name + "\" appears twice");
-    reader.OnlyKeys(entry, {"name", "width", "height", "K", "R", "t", "distortion"}, where);
-    const int width = reader.PositiveInt(reader.Required(entry, "width", where), where + ".width");
-    const int height = reader.PositiveInt(reader.Required(entry, "height", where), where + ".height");
-    const Eigen::Matrix3d K = reader.Matrix3(reader.Required(entry, "K", where), where + ".K");
-    const Eigen::Matrix3d R = reader.Matrix3(reader.Required(entry, "R", where), where + ".R");
-    const Eigen::Vector3d t = reader.Vector(reader.Required(entry, "t", where), 3, where + ".t");
+    reader.OnlyKeys(entry, {"name", "width", "height", "K", "R", "t", "distortion", "distortion_model"}, where);
+    const int width = static_cast<int>(
+        reader.Integer(reader.Required(entry, "width", where), where + ".width", 1, kMaxImageSide));
+    const int height = static_cast<int>(
+        reader.Integer(reader.Required(entry, "height", where), where + ".height", 1, kMaxImageSide));
+    const Eigen::Matrix3d K = Matrix3(reader, reader.Required(entry, "K", where), where + ".K");
+    const Eigen::Matrix3d R = Matrix3(reader, reader.Required(entry, "R", where), where + ".R");
+    const Eigen::Vector3d t = Vector(reader, reader.Required(entry, "t", where), 3, where + ".t");
     Eigen::VectorXd distortion;
-    if (entry.contains("distortion"))
-      distortion = reader.Vector(entry["distortion"], -1, where + ".distortion");
-    cameras.emplace_back(name, width, height, K, R, t, distortion, path);
+    if (const json* values = reader.Optional(entry, "distortion", where))
+      distortion = Vector(reader, *values, -1, where + ".distortion");
+    DistortionModel model = DistortionModel::kOpenCV;
+    if (const json* value = reader.Optional(entry, "distortion_model", where)) {
+      if (!value->is_string() || !ParseDistortionModel(value->get<std::string>(), &model))
+        reader.Fail(where + ".distortion_model", "expected \"opencv\" or \"fisheye\", got " + value->dump());
+    }
+    cameras.emplace_back(name, width, height, K, R, t, distortion, path, model);
   }
   if (info) *info = parsed;
   return cameras;
@@ -243,6 +158,8 @@ void WriteCamerasJson(const std::string& path, const std::vector<Camera>& camera
     entry["R"] = MatrixJson(camera.R());
     entry["t"] = VectorJson(camera.t());
     entry["distortion"] = VectorJson(camera.distortion());
+    if (camera.distortion_model() != DistortionModel::kOpenCV)
+      entry["distortion_model"] = DistortionModelName(camera.distortion_model());
     list.push_back(entry);
   }
   root["cameras"] = list;

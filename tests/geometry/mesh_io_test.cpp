@@ -248,8 +248,8 @@ const char* const kTetrahedronVertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
 TEST_F(MeshIo, BadPlyFilesNameTheFileTheElementAndTheExpectation) {
   const std::string header = kAsciiHeader, vertices = kTetrahedronVertices;
   ExpectReadError(
-      WriteFile("quad.ply", header + vertices + "4 0 1 2 3\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
-      {"face 0", "has 4 vertices", "expected 3"});
+      WriteFile("segment.ply", header + vertices + "2 0 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
+      {"face 0", "has 2 vertices", "expected a polygon of 3 to"});
   ExpectReadError(
       WriteFile("nan.ply",
                 header + "0 0 0\n1 nan 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n"),
@@ -295,8 +295,9 @@ TEST_F(MeshIo, TruncatedOrNonFiniteBinaryPlyIsRejected) {
   const std::string bytes = ReadBytes(Path("full.ply"));
   ExpectReadError(WriteFile("cut.ply", bytes.substr(0, bytes.size() - 5)),
                   {"face 7", "truncated binary data", "announces 8 face elements"});
+  // Too short for the vertices the header announces: refused before reading (or allocating).
   ExpectReadError(WriteFile("cut_vertices.ply", bytes.substr(0, bytes.size() - 8 * 13 - 10)),
-                  {"vertex 5", "truncated binary data"});
+                  {"element vertex", "announces 6 elements of at least 12 bytes", "truncated"});
   // The first vertex's y coordinate sits 4 bytes after the header.
   std::string nan_bytes = bytes;
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -305,8 +306,8 @@ TEST_F(MeshIo, TruncatedOrNonFiniteBinaryPlyIsRejected) {
 }
 
 TEST_F(MeshIo, BadObjFilesNameTheLineAndTheFace) {
-  ExpectReadError(WriteFile("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n"),
-                  {"line 5 (face 0)", "has 4 vertices", "expected 3"});
+  ExpectReadError(WriteFile("segment.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2\n"),
+                  {"line 5 (face 0)", "has 2 vertices", "expected a polygon of at least 3"});
   ExpectReadError(WriteFile("range.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2 7\n"),
                   {"line 5 (face 1)", "vertex index 7 out of range [1, 3]"});
   ExpectReadError(WriteFile("relative.obj", "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 1 1 0\n"),

@@ -348,7 +348,7 @@ TEST_F(MalformedDataset, BadJson) {
   const std::string message = OpenError();
   EXPECT_CONTAINS(message, Json().string());
   EXPECT_CONTAINS(message, "line ");
-  EXPECT_CONTAINS(message, "expected valid JSON");
+  EXPECT_CONTAINS(message, "invalid JSON");
 }
 
 TEST_F(MalformedDataset, MissingField) {
@@ -380,7 +380,7 @@ TEST_F(MalformedDataset, NegativeWidth) {
   const std::string message = OpenError();
   EXPECT_CONTAINS(message, Json().string());
   EXPECT_CONTAINS(message, "cameras[0] (\"left\").width");
-  EXPECT_CONTAINS(message, "expected a positive integer");
+  EXPECT_CONTAINS(message, "expected an integer in [1, 32768]");
 }
 
 TEST_F(MalformedDataset, CameraWithNoImages) {

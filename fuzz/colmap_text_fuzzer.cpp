@@ -1,0 +1,21 @@
+// libFuzzer harness: the COLMAP text model importer (vision/colmap_import.h) on a fuzzed
+// folder with cameras.txt and images.txt (fuzz/fuzz_support.h), both naming rules.
+#include "fuzz/fuzz_support.h"
+#include "vision/colmap_import.h"
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  subflow::fuzz::QuietLogs();
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const auto root = subflow::fuzz::FreshScratch();
+  subflow::fuzz::WriteFileTree(data, size, root);
+  using Options = subflow::vision::ColmapImportOptions;
+  for (Options::NameFrom rule : {Options::NameFrom::kFileStem, Options::NameFrom::kParentFolder}) {
+    Options options;
+    options.name_from = rule;
+    subflow::fuzz::RunReader([&] { subflow::vision::ReadColmapTextModel(root.string(), options); });
+  }
+  return 0;
+}

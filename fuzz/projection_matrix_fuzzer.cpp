@@ -1,0 +1,30 @@
+// libFuzzer harness: the projection-matrix importers (vision/projection_matrix_import.h) on a
+// fuzzed folder (fuzz/fuzz_support.h): the matrix-file folder (image sizes from the
+// images beside them, or given), and a Middlebury "<name>_par.txt" in it.
+#include "fuzz/fuzz_support.h"
+#include "vision/projection_matrix_import.h"
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  subflow::fuzz::QuietLogs();
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  namespace fs = std::filesystem;
+  const auto root = subflow::fuzz::FreshScratch();
+  subflow::fuzz::WriteFileTree(data, size, root);
+  subflow::vision::ProjectionMatrixImportOptions given_size;
+  given_size.width = 64;
+  given_size.height = 48;
+  for (const auto& options : {subflow::vision::ProjectionMatrixImportOptions{}, given_size}) {
+    subflow::fuzz::RunReader([&] { subflow::vision::ReadProjectionMatrixFolder(root.string(), options); });
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator(root, error)) {
+      const std::string name = entry.path().filename().string();
+      if (name.size() > 8 && name.compare(name.size() - 8, 8, "_par.txt") == 0)
+        subflow::fuzz::RunReader(
+            [&] { subflow::vision::ReadMiddleburyParameters(entry.path().string(), options); });
+    }
+  }
+  return 0;
+}
