@@ -7,19 +7,21 @@
 #   subflow eval SCENE RUNS/SCENE/hull --hull --json …/eval_mask_hull.json
 # one at a time, then prints the table (scripts/baseline_table.py).
 #   scripts/baseline_scenes.sh [SCENES_DIR=/work/scenes] [RUNS_DIR=/work/scenes/runs] [SUBFLOW] [SCENE...]
+# Environment: FRAMES=N reconstructs (and hulls) the first N frames only; SKIP_RECONSTRUCT=1
+# keeps an existing result and only redoes the hull and the evaluations.
 set -euo pipefail
 SCENES=${1:-/work/scenes}
 RUNS=${2:-/work/scenes/runs}
 SUBFLOW=${3:-build/cli/subflow}
 shift $(( $# > 3 ? 3 : $# )) || true
 LIST=("$@")
-[ ${#LIST[@]} -gt 0 ] || LIST=(bust_front mug_ring pair_dome critter_nomasks bust_still bust_still_bare take_hd)
+[ ${#LIST[@]} -gt 0 ] || LIST=(bust_front mug_ring pair_dome critter_nomasks bust_still bust_still_bare take_small)
 
 mask_scene() {  # the dataset with the same images and masks
   case $1 in
     critter_nomasks) echo critter_ring ;;
     bust_still_bare) echo bust_still ;;
-    take_hd) echo "" ;;
+    take_small|take_hd) echo "" ;;
     *) echo "$1" ;;
   esac
 }
@@ -28,13 +30,18 @@ for name in "${LIST[@]}"; do
   d="$SCENES/$name"; r="$RUNS/$name"
   [ -d "$d" ] || { echo "skip $name: no dataset $d"; continue; }
   mkdir -p "$r"
-  echo "== $name: reconstruct"
-  /usr/bin/time -v "$SUBFLOW" reconstruct "$d" --out "$r/result" --overwrite > "$r/reconstruct.log" 2> "$r/reconstruct.time" || {
-    echo "reconstruct failed: see $r/reconstruct.time"; continue; }
+  range=()
+  [ -z "${FRAMES:-}" ] || range=(--frames "$FRAMES")
+  if [ -z "${SKIP_RECONSTRUCT:-}" ]; then
+    echo "== $name: reconstruct ${range[*]}"
+    /usr/bin/time -v "$SUBFLOW" reconstruct "$d" --out "$r/result" --overwrite "${range[@]}" > "$r/reconstruct.log" \
+      2> "$r/reconstruct.time" || { echo "reconstruct failed: see $r/reconstruct.time"; continue; }
+  fi
   m=$(mask_scene "$name")
   if [ -n "$m" ] && [ -d "$SCENES/$m/masks" ]; then
     echo "== $name: exact-mask hull from $m"
-    /usr/bin/time -v "$SUBFLOW" hull "$SCENES/$m" --out "$r/hull" --evidence mask --overwrite > "$r/hull.log" 2> "$r/hull.time"
+    /usr/bin/time -v "$SUBFLOW" hull "$SCENES/$m" --out "$r/hull" --evidence mask --overwrite "${range[@]}" \
+      > "$r/hull.log" 2> "$r/hull.time"
     "$SUBFLOW" eval "$d" "$r/hull" --hull --json "$r/eval_mask_hull.json" > "$r/eval_mask_hull.txt" 2>/dev/null
   fi
   echo "== $name: eval"

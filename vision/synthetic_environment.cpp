@@ -122,6 +122,10 @@ SoftShadows::SoftShadows(const EnvironmentOptions& options, const Eigen::Vector3
   const Eigen::Vector3d e1 = L.unitOrthogonal(), e2 = L.cross(e1);
   const int n = options.shadow_samples, size = 1024;
   const double cone = options.shadow_cone_degrees * kPi / 180.0, distance = 20.0;
+  centre_ = centre;
+  light_ = L;
+  radius_ = radius;
+  cone_tangent_ = std::tan(cone);
   for (int i = 0; i < n; ++i) {
     const double r = cone * std::sqrt((i + 0.5) / n), phi = 2.399963229728653 * i;
     const Eigen::Vector3d direction = (L + std::tan(r) * (std::cos(phi) * e1 + std::sin(phi) * e2)).normalized();
@@ -133,6 +137,13 @@ SoftShadows::SoftShadows(const EnvironmentOptions& options, const Eigen::Vector3
 
 double SoftShadows::LightFraction(const Eigen::Vector3d& X) const {
   if (maps_.empty()) return 1.0;
+  // Outside the subject's shadow volume (the cylinder of its bounding sphere away from the
+  // light, widened by the cone) every direction is lit: skip the maps.
+  const Eigen::Vector3d offset = X - centre_;
+  const double towards_light = offset.dot(light_);
+  if (towards_light > radius_) return 1.0;
+  const double across = (offset - towards_light * light_).norm();
+  if (across > radius_ * 1.01 + std::abs(towards_light) * cone_tangent_ + bias_) return 1.0;
   int lit = 0;
   for (const ZBuffer& map : maps_) {
     const Eigen::Vector2d p = map.camera().ProjectUndistorted(X);

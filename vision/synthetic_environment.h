@@ -96,6 +96,8 @@ class SoftShadows {
  private:
   std::vector<ZBuffer> maps_;
   double bias_ = 0.002;
+  Eigen::Vector3d centre_ = Eigen::Vector3d::Zero(), light_ = Eigen::Vector3d::UnitZ();
+  double radius_ = 0.0, cone_tangent_ = 0.0;  // the subject's bounding sphere, the light's cone
 };
 
 }  // namespace subflow::vision

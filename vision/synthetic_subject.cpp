@@ -223,28 +223,52 @@ void SdfMeshOptions::Check() const {
   if (newton_steps < 0 || newton_steps > 20) ThrowError("synthetic subject", "newton_steps", "expected 0..20");
 }
 
-geometry::TriangleMesh MeshSdfSubject(const SdfSubject& subject, const SdfMeshOptions& options,
-                                      Progress* progress) {
-  options.Check();
-  const double h = options.voxel_size;
-  const Vector3d origin = subject.box_min - Vector3d::Constant(3.0 * h);
-  const Eigen::Vector3i n = ((subject.box_max - subject.box_min) / h).array().ceil().cast<int>() + 7;
+namespace {
+
+// The SDF sampled as the occupancy-like field of the header, on a grid whose origin is
+// shifted by `shift` voxels.
+geometry::ScalarVolume SampleSdf(const SdfSubject& subject, double h, double shift) {
+  const Vector3d origin = subject.box_min - Vector3d::Constant((3.0 + shift) * h);
+  const Eigen::Vector3i n = ((subject.box_max - subject.box_min) / h).array().ceil().cast<int>() + 8;
   geometry::ScalarVolume volume(origin, h, n.x(), n.y(), n.z());
-  ProgressBegin(progress, "synth: sampling the " + subject.name + " SDF", static_cast<std::size_t>(n.z()));
   tbb::parallel_for(0, n.z(), [&](int k) {
     for (int j = 0; j < n.y(); ++j)
       for (int i = 0; i < n.x(); ++i)
         volume.at(i, j, k) =
             static_cast<float>(std::clamp(0.5 - subject.sdf(volume.VoxelCenter(i, j, k)) / (4.0 * h), 0.0, 1.0));
   });
-  ProgressEnd(progress);
+  return volume;
+}
+
+}  // namespace
+
+geometry::TriangleMesh MeshSdfSubject(const SdfSubject& subject, const SdfMeshOptions& options,
+                                      Progress* progress) {
+  options.Check();
+  const double h = options.voxel_size;
   geometry::IsosurfaceOptions iso;
   iso.iso_value = 0.5;
   iso.smoothing_sigma_voxels = 0.0;
   iso.facet_size_voxels = options.facet_size_voxels;
   iso.facet_distance_voxels = 0.1;
   iso.facet_angle_degrees = 25.0;
-  geometry::TriangleMesh mesh = geometry::ExtractIsosurface(volume, iso, nullptr, "synthetic " + subject.name);
+  // Mesh_3, started from geometry::FindIsosurfaceSeeds, sometimes ends with no surface
+  // facet (the thin-walled mug at some voxel sizes; reported with branch `scenes`): the
+  // grid is then shifted by a fraction of a voxel, which changes the seeds, and tried again.
+  constexpr int kAttempts = 6;
+  ProgressBegin(progress, "synth: meshing the " + subject.name + " SDF", kAttempts);
+  geometry::TriangleMesh mesh;
+  for (int attempt = 0;; ++attempt) {
+    const geometry::ScalarVolume volume = SampleSdf(subject, h, 0.37 * attempt);
+    try {
+      mesh = geometry::ExtractIsosurface(volume, iso, nullptr, "synthetic " + subject.name);
+      break;
+    } catch (const Error&) {
+      if (attempt + 1 >= kAttempts) throw;
+    }
+    ProgressUpdate(progress, static_cast<std::size_t>(attempt + 1));
+  }
+  ProgressEnd(progress);
   // Newton projection onto the SDF's zero set (the gradient step h/4 resolves 3 mm plates).
   tbb::parallel_for(Eigen::Index{0}, mesh.V.rows(), [&](Eigen::Index v) {
     Vector3d x = mesh.V.row(v).transpose();

@@ -13,7 +13,9 @@
 #include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "geometry/vertex_normals.h"
+#include "vision/camera_rig.h"
 #include "vision/dataset.h"
+#include "vision/dataset_writer.h"
 #include "vision/synthetic_scene.h"
 #include "tests/test_support.h"
 
@@ -318,6 +320,46 @@ TEST(Evaluation, CommandLinePrintsATableAndWritesJson) {
       "eval '" + files.dataset.string() + "' '" + (files.root / "nowhere").string() + "'", files.root);
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output().find("nowhere/meshes: missing"), std::string::npos) << bad.output();
+}
+
+TEST(Evaluation, CommandLineScoresTheObservedSurfaceAndHulls) {
+  // With the dataset's cameras (a ring of 4 around the blob), the JSON has the observed
+  // figures with the requested --min-views; --hull scores RESULT/hull/ without flow.
+  EvaluationFiles files("observed");
+  const SyntheticScene truth = Blob(2);
+  files.Write(truth, true);
+  CameraRigOptions rig;
+  rig.camera_count = 4;
+  WriteCamerasJson((files.dataset / "cameras.json").string(), MakeCameraRig(rig), std::nullopt, std::nullopt,
+                   std::nullopt);
+  fs::create_directories(files.result / "hull");
+  for (int f = 0; f < 2; ++f)
+    geometry::WriteMesh((files.result / "hull" / (FrameName(f) + ".ply")).string(), Blob(1).Mesh(0));
+  const fs::path json_path = files.root / "observed.json", hull_json = files.root / "hull.json";
+  const test::CommandResult run = test::RunSubflow("eval '" + files.dataset.string() + "' '" + files.result.string() +
+                                                       "' --samples 5000 --min-views 3 --json '" + json_path.string() + "'",
+                                                   files.root);
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  EXPECT_NE(run.output().find("observed surface: seen by >= 3 of 4 cameras"), std::string::npos) << run.output();
+  std::ifstream json_file(json_path);
+  const nlohmann::json json = nlohmann::json::parse(json_file);
+  EXPECT_EQ(json["min_views"].get<int>(), 3);
+  EXPECT_EQ(json["camera_count"].get<int>(), 4);
+  const nlohmann::json& observed = json["overall"]["observed"];
+  // Four cameras at 10° elevation: three of them see a band around the blob, not its poles.
+  EXPECT_GT(observed["observed_fraction"].get<double>(), 0.05);
+  EXPECT_LT(observed["observed_fraction"].get<double>(), 0.95);
+  EXPECT_GT(observed["pixel_footprint"].get<double>(), 0.0);
+  EXPECT_LT(observed["accuracy"].get<double>(), 1e-7);
+  const test::CommandResult hull = test::RunSubflow("eval '" + files.dataset.string() + "' '" + files.result.string() +
+                                                        "' --samples 5000 --hull --json '" + hull_json.string() + "'",
+                                                    files.root);
+  ASSERT_EQ(hull.exit_code, 0) << hull.output();
+  std::ifstream hull_file(hull_json);
+  const nlohmann::json hull_scores = nlohmann::json::parse(hull_file);
+  EXPECT_EQ(hull_scores["surfaces"].get<std::string>(), "hull");
+  EXPECT_TRUE(hull_scores["overall"]["flow"].is_null());
+  EXPECT_GT(hull_scores["overall"]["observed"]["accuracy"].get<double>(), 1e-4);  // frame 1's truth moved
 }
 
 }  // namespace
