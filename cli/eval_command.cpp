@@ -16,7 +16,7 @@
 #include "cli/progress_bar.h"
 #include "core/error.h"
 #include "geometry/mesh_io.h"
-#include "solver/rigid_motion.h"
+#include "solver/rigid/rigid_motion.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
 

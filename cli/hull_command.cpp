@@ -15,7 +15,7 @@
 #include "cli/stage_options.h"
 #include "geometry/mesh_io.h"
 #include "output/result_writer.h"
-#include "solver/shape_init.h"
+#include "solver/shape/shape_init.h"
 #include "vision/dataset.h"
 
 namespace subflow::cli {

@@ -66,9 +66,9 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   std::vector<std::vector<geometry::Positions>> levels;
   for (int i = 0; i < frames; ++i) {
     surfaces.push_back(result.Surface(i));
-    levels.push_back(result.trajectory[i].SynthesizeLevels(hierarchy, finest));
+    levels.push_back(result.split.trajectory[i].SynthesizeLevels(hierarchy, finest));
   }
-  const solver::FlowAnalysis flow = solver::AnalyzeFlow(surfaces, result.rigid);
+  const solver::FlowAnalysis flow = solver::AnalyzeFlow(surfaces, result.split.rigid);
   output::WriteResultMeshes(arguments.out, result.first_frame, hierarchy.LevelFaces(finest), surfaces,
                             FlowProperties(flow));
   output::WriteObjSequence(arguments.out, result.first_frame, hierarchy.LevelFaces(finest), surfaces);
@@ -83,7 +83,7 @@ write_start.Seconds();
   report["motion_init"] = MotionInitJson(options.motion, result.motion, result.first_frame);
   if (result.retrack) report["retrack"] = MotionInitJson(options.motion, *result.retrack, result.first_frame);
   if (result.refinement) report["refinement"] = RefinementJson(options.refinement, *result.refinement, result.first_frame);
-  report["rigid_motion"] = RigidMotionJson(result.rigid, result.first_frame);
+  report["rigid_motion"] = RigidMotionJson(result.split.rigid, result.first_frame);
   double mean_flow = 0, mean_non_rigid = 0;
   for (int i = 0; i + 1 < frames; ++i) {
     mean_flow += solver::FlowMagnitudes(flow.flow[i]).mean() / (frames - 1);
@@ -98,7 +98,7 @@ write_start.Seconds();
                                {"motion_init", result.motion_seconds},
                                {"refinement", result.refinement_seconds},
                                {"retrack", result.retrack_seconds},
-                               {"rigid_split", result.analysis_seconds},
+                               {"rigid_split", result.split.seconds},
                                {"writing", write_seconds},
                                {"total", total}};
   report["total_seconds"] = total;

@@ -1,5 +1,7 @@
 #include "cli/reconstruct_report.h"
 
+#include "cli/stage_options.h"
+
 #include <cmath>
 
 namespace subflow::cli {
@@ -62,8 +64,8 @@ nlohmann::json RefinementJson(const solver::StereoRefinementOptions& o, const so
            {{"coarsest_level", o.coarsest_level}, {"finest_level", o.finest_level},
             {"normal_only_from_level", o.normal_only_from_level}, {"window", o.window},
             {"window_overlap", o.window_overlap},
-            {"rounds", o.rounds}, {"max_iterations", o.max_iterations},
-            {"linear_solver", o.linear_solver}, {"threads", o.threads},
+            {"rounds", o.rounds}, {"max_iterations", o.solver.max_iterations},
+            {"linear_solver", LinearSolverName(o.solver.linear_solver)}, {"threads", o.solver.threads},
             {"samples_per_pixel", o.samples_per_pixel}, {"min_density", o.min_density},
             {"max_density", o.max_density}, {"max_cameras", o.max_cameras},
             {"min_samples", o.min_samples}, {"image_sigma", o.image_sigma},

@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "solver/shape_init.h"
+#include "solver/shape/shape_init.h"
 #include "vision/dataset.h"
 
 namespace subflow::cli {

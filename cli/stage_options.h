@@ -5,9 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "solver/motion_init.h"
-#include "solver/shape_init.h"
-#include "solver/stereo_refinement.h"
+#include "solver/motion/motion_init.h"
+#include "solver/shape/shape_init.h"
+#include "solver/stereo/stereo_refinement.h"
 
 namespace subflow::cli {
 
@@ -23,6 +23,9 @@ void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::
 
 // --motion-smoothness, --hull-weight.
 void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options);
+
+// Ceres's name of a linear solver type, lower case ("sparse_normal_cholesky").
+std::string LinearSolverName(ceres::LinearSolverType type);
 
 // --refine-from, --refine-to, --window, --window-overlap, --rounds, --iterations,
 // --linear-solver, --threads, --samples-per-pixel, --max-cameras and the term weights.
