@@ -1,15 +1,8 @@
 #include "cli/stage_options.h"
 
-#include <algorithm>
-#include <cctype>
+#include "output/options_json.h"
 
 namespace subflow::cli {
-
-std::string LinearSolverName(ceres::LinearSolverType type) {
-  std::string name = ceres::LinearSolverTypeToString(type);
-  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
-  return name;
-}
 
 void AddDatasetAndOutput(CLI::App* sub, std::string* dataset, std::string* out, bool* overwrite) {
   sub->add_option("DATASET", *dataset, "Dataset directory (../shared/DATASET.md)")
@@ -86,7 +79,7 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
                                         "(e.g. sparse_normal_cholesky, sparse_schur, iterative_schur, cgnr, dense_qr)");
          },
          "Ceres linear solver type (ceres::LinearSolverType, any case)")
-      ->default_str(LinearSolverName(o->solver.linear_solver));
+      ->default_str(nlohmann::json(o->solver.linear_solver).get<std::string>());
   sub->add_option("--threads", o->solver.threads, "Ceres threads (0 = all cores)")->capture_default_str();
   sub->add_option("--samples-per-pixel", o->samples_per_pixel,
                   "Surface samples per pixel² of a patch's finest view")->capture_default_str();

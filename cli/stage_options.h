@@ -24,9 +24,6 @@ void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::
 // --motion-smoothness, --hull-weight.
 void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options);
 
-// Ceres's name of a linear solver type, lower case ("sparse_normal_cholesky").
-std::string LinearSolverName(ceres::LinearSolverType type);
-
 // --refine-from, --refine-to, --window, --window-overlap, --rounds, --iterations,
 // --linear-solver, --threads, --samples-per-pixel, --max-cameras and the term weights.
 void AddRefinementOptions(CLI::App* app, solver::StereoRefinementOptions* options);

@@ -20,6 +20,13 @@ MotionInitOptions ReconstructionOptions::RetrackOptions() const {
   return retrack;
 }
 
+std::string ReconstructionResult::BriefReport() const {
+  std::string lines = shape.BriefReport() + "\n" + motion.BriefReport();
+  if (refinement) lines += "\n" + refinement->BriefReport();
+  if (retrack) lines += "\nretrack: " + retrack->BriefReport();
+  return lines + "\n" + split.BriefReport();
+}
+
 geometry::Positions ReconstructionResult::Surface(int i) const {
   const geometry::LoopHierarchy& h = hierarchy();
   return h.LimitPositions(h.finest_level()) * control.at(i);

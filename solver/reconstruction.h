@@ -6,6 +6,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/progress.h"
@@ -47,6 +48,9 @@ struct ReconstructionResult {
   std::vector<geometry::Positions> control;  // final finest control points per frame
   RigidSplit split;                          // their multires analysis and rigid motions
   double shape_seconds = 0, motion_seconds = 0, refinement_seconds = 0, retrack_seconds = 0;
+
+  // The stages' brief reports, one line each.
+  std::string BriefReport() const;
 
   const geometry::LoopHierarchy& hierarchy() const { return *shape.hierarchy; }
   // The output surface of frame i (0-based within the processed frames): the limit

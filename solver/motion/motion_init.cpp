@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include "core/error.h"
@@ -14,6 +15,20 @@
 namespace subflow::solver {
 
 using geometry::Positions;
+
+std::string MotionInitResult::BriefReport() const {
+  double zero = 0, estimated = 0;
+  int steps = 0;
+  for (const MotionFrameReport& frame : frames) {
+    if (frame.from_frame < 0) continue;
+    zero += frame.step.photometric_rms_zero;
+    estimated += frame.step.photometric_rms;
+    ++steps;
+  }
+  return fmt::format("motion init: {} frames from reference {}, photometric RMS {:.4f} (zero motion) → {:.4f}, {:.1f} s",
+                     frames.size(), reference_frame, steps ? zero / steps : 0.0, steps ? estimated / steps : 0.0,
+                     seconds);
+}
 
 void MotionInitOptions::Check() const {
   step.Check();

@@ -16,6 +16,7 @@
 // (solver/rigid/rigid_split.h: SplitRigidMotion).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "core/progress.h"
@@ -52,6 +53,9 @@ struct MotionInitResult {
   std::vector<geometry::Positions> control;  // per frame: finest control points #V(n)×3
   std::vector<MotionFrameReport> frames;     // per frame
   double seconds = 0.0;
+
+  // One line: frames, reference, photometric RMS of zero motion → estimated, seconds.
+  std::string BriefReport() const;
 };
 
 // Trajectories for the frames of `images` (its gray images; frames and reference_frame

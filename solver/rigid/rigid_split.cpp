@@ -1,11 +1,23 @@
 #include "solver/rigid/rigid_split.h"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
+
+#include <spdlog/fmt/fmt.h>
 
 #include "core/error.h"
 #include "core/stopwatch.h"
 
 namespace subflow::solver {
+
+std::string RigidSplit::BriefReport() const {
+  double angle = 0, residual = 0;
+  for (const RigidMotion& step : rigid) angle += step.RotationAngle(), residual += step.rms_residual;
+  const double steps = std::max<std::size_t>(1, rigid.size());
+  return fmt::format("rigid split: {} frame steps, mean rotation {:.3f}° per step, mean fit residual {:.3g}",
+                     rigid.size(), angle / steps * 180.0 / M_PI, residual / steps);
+}
 
 RigidSplit SplitRigidMotion(const geometry::LoopHierarchy& hierarchy,
                             const std::vector<geometry::Positions>& control) {

@@ -6,6 +6,7 @@
 // from AnalyzeFlow on its positions with these rigid motions.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "geometry/loop_hierarchy.h"
@@ -18,6 +19,9 @@ struct RigidSplit {
   geometry::Trajectory trajectory;  // per frame: multires analysis of the control points
   std::vector<RigidMotion> rigid;   // per frame step f → f + 1 (frames − 1)
   double seconds = 0.0;
+
+  // One line: frame steps, mean rotation per step, mean fit residual.
+  std::string BriefReport() const;
 };
 
 // `control`: per frame, the finest control points (#V(n)×3). Throws subflow::Error when

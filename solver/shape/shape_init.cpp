@@ -1,9 +1,11 @@
 #include "solver/shape/shape_init.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include "core/stopwatch.h"
@@ -48,6 +50,21 @@ void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std:
 }
 
 }  // namespace
+
+std::string ShapeInitResult::BriefReport() const {
+  double iou = 0, seconds = estimate_background_seconds + simplify_seconds;
+  int with_iou = 0;
+  for (const FrameShapeInit& frame : frames) {
+    if (std::isfinite(frame.carving.mean_silhouette_iou)) iou += frame.carving.mean_silhouette_iou, ++with_iou;
+    seconds += frame.carve_seconds + frame.isosurface_seconds + frame.fit_seconds;
+  }
+  const int levels = hierarchy ? hierarchy->finest_level() : 0;
+  return fmt::format("shape init: {} frames ({}–{}), reference {}, base mesh {} vertices / {} faces, {} levels "
+                     "(finest {} faces), mean silhouette IoU {:.4f}, {:.1f} s",
+                     frames.size(), frames.empty() ? 0 : frames.front().frame, frames.empty() ? 0 : frames.back().frame,
+                     reference_frame, base_mesh.vertex_count(), base_mesh.face_count(), levels,
+                     hierarchy ? hierarchy->FaceCount(levels) : 0, with_iou ? iou / with_iou : 0.0, seconds);
+}
 
 void ShapeInitOptions::Check() const {
   carving.Check();

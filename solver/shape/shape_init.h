@@ -76,6 +76,9 @@ struct ShapeInitResult {
   std::vector<vision::EstimatedBackground> estimated_backgrounds;
   double estimate_background_seconds = 0;
   double simplify_seconds = 0;
+
+  // One line: frames, base mesh, levels, mean silhouette IoU, seconds.
+  std::string BriefReport() const;
 };
 
 // Runs the whole stage on `dataset`. Throws subflow::Error on bad input (see the

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <Eigen/Geometry>
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include "core/error.h"
@@ -162,6 +163,25 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
 }
 
 }  // namespace
+
+std::string RefinementResult::BriefReport() const {
+  std::string level_list;
+  int iterations = 0;
+  double solver_seconds = 0;
+  for (const RefinementLevelReport& level : levels) {
+    level_list += fmt::format("{}{} ({:.0f} %)", level_list.empty() ? "" : ", ", level.level, 100 * level.active_fraction);
+    iterations += level.iterations;
+    solver_seconds += level.solver_seconds;
+  }
+  double before = 0, after = 0;
+  int refined = 0;
+  for (const RefinementFrameReport& frame : frames)
+    if (frame.stereo_pairs > 0) before += frame.ncc_before, after += frame.ncc_after, ++refined;
+  return fmt::format("refinement: levels {}, {} Ceres iterations, mean NCC {:.4f} → {:.4f} over {} frames, "
+                     "{:.1f} s ({:.1f} s in Ceres)",
+                     level_list, iterations, refined ? before / refined : 0.0, refined ? after / refined : 0.0,
+                     refined, seconds, solver_seconds);
+}
 
 void WindowSolverOptions::Check() const {
   if (max_iterations < 1) ThrowError("stereo refinement options", "solver.max_iterations", "must be ≥ 1");

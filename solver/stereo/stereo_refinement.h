@@ -161,6 +161,9 @@ struct RefinementResult {
   std::vector<RefinementLevelReport> levels;
   std::vector<RefinementFrameReport> frames;
   double seconds = 0;
+
+  // One line: levels with their active fractions, iterations, mean NCC before → after, seconds.
+  std::string BriefReport() const;
 };
 
 // `control`: the finest control points of every frame of `images` (#V(n)×3 each,

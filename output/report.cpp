@@ -1,4 +1,4 @@
-#include "cli/report_json.h"
+#include "output/report.h"
 
 #include <cmath>
 
@@ -7,7 +7,9 @@
 #include <opencv2/core/version.hpp>
 #include <spdlog/version.h>
 
-namespace subflow::cli {
+#include "output/options_json.h"
+
+namespace subflow::output {
 namespace {
 
 nlohmann::json Finite(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
@@ -41,78 +43,16 @@ nlohmann::json DatasetJson(const vision::Dataset& dataset) {
           {"has_videos", dataset.has_videos()}};
 }
 
-nlohmann::json SilhouetteOptionsJson(const vision::SilhouetteOptions& o) {
-  return {{"source", vision::ToString(o.source)},
-          {"background_blur_sigma", o.background_blur_sigma},
-          {"background_threshold", o.background_threshold},
-          {"background_method", vision::ToString(o.background_method)},
-          {"background_open_radius", o.background_open_radius},
-          {"background_min_threshold", o.background_min_threshold},
-          {"background_contour_fraction", o.background_contour_fraction},
-          {"motion_sigma", o.motion_sigma},
-          {"motion_lambda", o.motion_lambda},
-          {"motion_window", o.motion_window},
-          {"motion_threshold", o.motion_threshold},
-          {"motion_method", vision::ToString(o.motion_method)},
-          {"motion_min_threshold", o.motion_min_threshold},
-          {"close_radius", o.close_radius},
-          {"fill_holes", o.fill_holes},
-          {"min_region_pixels", o.min_region_pixels},
-          {"min_object_pixels", o.min_object_pixels}};
+nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset) {
+  return {{"command", run.command},
+          {"output", run.out},
+          {"overwrite", run.overwrite},
+          {"versions", VersionsJson()},
+          {"dataset", DatasetJson(dataset)}};
 }
 
-nlohmann::json VoxelCarvingOptionsJson(const vision::VoxelCarvingOptions& o) {
-  return {{"resolution", o.resolution},
-          {"pixels_per_voxel", o.pixels_per_voxel},
-          {"max_auto_resolution", o.max_auto_resolution},
-          {"min_cameras", o.min_cameras},
-          {"max_misses", o.max_misses},
-          {"evidence_threshold", o.evidence_threshold},
-          {"footprint_margin", o.footprint_margin},
-          {"closing_radius", o.closing_radius},
-          {"opening_radius", o.opening_radius},
-          {"connectivity", o.connectivity},
-          {"min_component_fraction", o.min_component_fraction},
-          {"fill_cavities", o.fill_cavities},
-          {"compute_silhouette_iou", o.compute_silhouette_iou},
-          {"threads", o.threads}};
-}
-
-nlohmann::json ShapeInitOptionsJson(const solver::ShapeInitOptions& o) {
-  return {
-      {"levels", o.levels},
-      {"reference_frame", o.reference_frame},
-      {"first_frame", o.first_frame},
-      {"frame_count", o.frame_count},
-      {"silhouettes", SilhouetteOptionsJson(o.silhouettes)},
-      {"carving", VoxelCarvingOptionsJson(o.carving)},
-      {"isosurface",
-       {{"iso_value", o.isosurface.iso_value},
-        {"smoothing_sigma_voxels", o.isosurface.smoothing_sigma_voxels},
-        {"padding_voxels", o.isosurface.padding_voxels},
-        {"facet_angle_degrees", o.isosurface.facet_angle_degrees},
-        {"facet_size_voxels", o.isosurface.facet_size_voxels},
-        {"facet_distance_voxels", o.isosurface.facet_distance_voxels},
-        {"max_vertex_count", o.isosurface.max_vertex_count},
-        {"random_seed", o.isosurface.random_seed}}},
-      {"simplify",
-       {{"target_face_count", o.simplify.target_face_count},
-        {"max_normal_change_degrees", o.simplify.max_normal_change_degrees},
-        {"min_triangle_angle_degrees", o.simplify.min_triangle_angle_degrees},
-        {"max_valence", o.simplify.max_valence},
-        {"min_valence", o.simplify.min_valence},
-        {"flip_rounds", o.simplify.flip_rounds},
-        {"max_flip_dihedral_degrees", o.simplify.max_flip_dihedral_degrees},
-        {"check_self_intersections", o.simplify.check_self_intersections},
-        {"max_attempts", o.simplify.max_attempts},
-        {"retry_growth", o.simplify.retry_growth}}},
-      {"fit",
-       {{"iterations_per_level", o.fit.iterations_per_level},
-        {"max_snap_distance", o.fit.max_snap_distance}}}};
-}
-
-nlohmann::json ShapeInitReport(const vision::Dataset& dataset, const solver::ShapeInitOptions& options,
-                               const solver::ShapeInitResult& result) {
+nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::ShapeInitOptions& options,
+                             const solver::ShapeInitResult& result) {
   const auto& hierarchy = *result.hierarchy;
   nlohmann::json levels = nlohmann::json::array();
   for (int level = 0; level <= hierarchy.finest_level(); ++level)
@@ -179,20 +119,74 @@ nlohmann::json ShapeInitReport(const vision::Dataset& dataset, const solver::Sha
     isosurface += frame.isosurface_seconds;
     fit += frame.fit_seconds;
   }
-  return {{"versions", VersionsJson()},
-          {"dataset", DatasetJson(dataset)},
-          {"options", {{"shape_init", ShapeInitOptionsJson(options)}}},
-          {"shape_init",
-           {{"reference_frame", result.reference_frame},
-            {"base_mesh", {{"vertices", result.base_mesh.vertex_count()},
-                           {"faces", result.base_mesh.face_count()},
-                           {"valence_histogram", valences},
-                           {"simplify_attempts", result.simplify.attempts}}},
-            {"levels", levels},
-            {"estimated_background", estimated},
-            {"frames", frames},
-            {"seconds", {{"carve", carve}, {"isosurface", isosurface}, {"simplify", result.simplify_seconds},
-                         {"fit", fit}}}}}};
+  return {{"reference_frame", result.reference_frame},
+          {"base_mesh", {{"vertices", result.base_mesh.vertex_count()},
+                         {"faces", result.base_mesh.face_count()},
+                         {"valence_histogram", valences},
+                         {"simplify_attempts", result.simplify.attempts}}},
+          {"levels", levels},
+          {"estimated_background", estimated},
+          {"frames", frames},
+          {"seconds", {{"carve", carve}, {"isosurface", isosurface}, {"simplify", result.simplify_seconds},
+                       {"fit", fit}}}};
 }
 
-}  // namespace subflow::cli
+nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::MotionInitResult& result,
+                              int first_frame) {
+  nlohmann::json frames = nlohmann::json::array();
+  for (const solver::MotionFrameReport& f : result.frames) {
+    frames.push_back({{"frame", first_frame + f.frame},
+                      {"from_frame", f.from_frame < 0 ? -1 : first_frame + f.from_frame},
+                      {"constraints", f.step.constraints},
+                      {"pruned", f.step.pruned},
+                      {"collinearity_pruned", f.step.collinearity_pruned},
+                      {"photometric_rms_zero_motion", f.step.photometric_rms_zero},
+                      {"photometric_rms", f.step.photometric_rms},
+                      {"mean_displacement", f.step.mean_displacement},
+                      {"cg_iterations", f.step.cg_iterations},
+                      {"corrected", f.corrected},
+                      {"correction_rms_before", f.correction_rms_before},
+                      {"correction_rms_after", f.correction_rms_after},
+                      {"seconds", f.step.seconds}});
+  }
+  return {{"options", o},
+          {"reference_frame", first_frame + result.reference_frame},
+          {"frames", frames},
+          {"seconds", result.seconds}};
+}
+
+nlohmann::json RefinementJson(const solver::StereoRefinementOptions& o, const solver::RefinementResult& result,
+                              int first_frame) {
+  nlohmann::json levels = nlohmann::json::array();
+  for (const solver::RefinementLevelReport& l : result.levels)
+    levels.push_back({{"level", l.level}, {"dof", l.dof}, {"patches", l.patches},
+                      {"active_patches", l.active_patches}, {"active_fraction", l.active_fraction},
+                      {"windows", l.windows},
+                      {"parameters", l.parameters}, {"residual_blocks", l.residual_blocks},
+                      {"mean_increment", l.mean_increment}, {"iterations", l.iterations},
+                      {"seconds", l.seconds}, {"solver_seconds", l.solver_seconds}});
+  nlohmann::json frames = nlohmann::json::array();
+  for (const solver::RefinementFrameReport& f : result.frames)
+    frames.push_back({{"frame", first_frame + f.frame}, {"stereo_pairs", f.stereo_pairs},
+                      {"ncc_before", f.ncc_before}, {"ncc_after", f.ncc_after},
+                      {"silhouette_rms_px_before", f.silhouette_rms_before},
+                      {"silhouette_rms_px_after", f.silhouette_rms_after}});
+  return {{"options", o},
+          {"levels", levels},
+          {"frames", frames},
+          {"seconds", result.seconds}};
+}
+
+nlohmann::json RigidMotionJson(const std::vector<solver::RigidMotion>& rigid, int first_frame) {
+  nlohmann::json steps = nlohmann::json::array();
+  for (std::size_t f = 0; f < rigid.size(); ++f)
+    steps.push_back({{"from_frame", first_frame + static_cast<int>(f)},
+                     {"to_frame", first_frame + static_cast<int>(f) + 1},
+                     {"v", Vector3(rigid[f].v)},
+                     {"omega", Vector3(rigid[f].omega)},
+                     {"rotation_degrees", rigid[f].RotationAngle() * 180.0 / M_PI},
+                     {"rms_residual", rigid[f].rms_residual}});
+  return steps;
+}
+
+}  // namespace subflow::output
