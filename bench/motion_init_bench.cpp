@@ -21,10 +21,11 @@
 #include "geometry/icosphere.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/mesh_io.h"
-#include "solver/motion_init.h"
-#include "solver/surface_snapping.h"
+#include "solver/motion/motion_init.h"
+#include "solver/shape/surface_snapping.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
+#include "vision/image_sequence.h"
 
 namespace {
 
@@ -170,10 +171,8 @@ void BM_BlobMotionInit(benchmark::State& state) {
   std::vector<Positions> initial =
       options.hull_weight > 0.0 ? blob.fits : std::vector<Positions>{blob.fits[0]};
   solver::MotionInitResult result;
-  for (auto _ : state)
-    result = solver::InitializeMotion(blob.dataset.cameras(), blob.frames,
-                                      [&](int k, int f) { return blob.dataset.Gray(k, f); },
-                                      blob.hierarchy, initial, 0, options);
+  const vision::ImageSequence images = vision::DatasetImages(blob.dataset, 0, blob.frames);
+  for (auto _ : state) result = solver::InitializeMotion(images, blob.hierarchy, initial, 0, options);
   double step_seconds = 0.0;
   for (int f = 1; f < blob.frames; ++f) step_seconds += result.frames[f].step.seconds;
   state.counters["seconds_per_step"] = step_seconds / std::max(1, blob.frames - 1);

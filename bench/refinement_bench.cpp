@@ -18,11 +18,11 @@
 
 #include "geometry/closest_point.h"
 #include "geometry/mesh_io.h"
-#include "solver/motion_init.h"
-#include "solver/reconstruction.h"
-#include "solver/shape_init.h"
-#include "solver/stereo_refinement.h"
+#include "solver/motion/motion_init.h"
+#include "solver/shape/shape_init.h"
+#include "solver/stereo/stereo_refinement.h"
 #include "vision/dataset.h"
+#include "vision/image_sequence.h"
 
 namespace {
 
@@ -34,6 +34,8 @@ constexpr int kFirstFrame = 10, kFrames = 3;
 struct Initialized {
   vision::Dataset dataset{SUBFLOW_SHARED_DIR "/data/blob"};
   solver::ShapeInitResult shape;
+  std::vector<geometry::TriangleMesh> hulls;
+  vision::ImageSequence images;
   std::vector<Positions> control;
   std::vector<geometry::ClosestPointTree> truth;
 
@@ -45,14 +47,12 @@ struct Initialized {
     const int finest = shape.hierarchy->finest_level();
     std::vector<Positions> fitted;
     for (const auto& frame : shape.frames) fitted.push_back(frame.control.at(finest));
-    control = solver::InitializeMotion(dataset.cameras(), kFrames, Gray(), *shape.hierarchy, fitted,
-                                       shape.reference_frame - kFirstFrame, {})
+    for (const auto& frame : shape.frames) hulls.push_back(frame.hull);
+    images = vision::DatasetImages(dataset, kFirstFrame, kFrames, vision::EvidenceSource::kAuto, &hulls);
+    control = solver::InitializeMotion(images, *shape.hierarchy, fitted, shape.reference_frame - kFirstFrame, {})
                   .control;
     for (int f = 0; f < kFrames; ++f)
       truth.emplace_back(geometry::ReadMesh(dataset.GroundTruthMeshPath(kFirstFrame + f)), "ground truth");
-  }
-  solver::GrayImageLoader Gray() const {
-    return [this](int camera, int frame) { return dataset.Gray(camera, kFirstFrame + frame); };
   }
   double MeanDistanceToTruth(const std::vector<Positions>& result) const {
     const geometry::LoopHierarchy& h = *shape.hierarchy;
@@ -75,14 +75,13 @@ const Initialized& State() {
 void BM_Refinement(benchmark::State& bench, const char* solver) {
   const Initialized& s = State();
   solver::StereoRefinementOptions options;
-  options.linear_solver = solver;
+  if (!ceres::StringToLinearSolverType(solver, &options.solver.linear_solver)) std::abort();
   options.rounds = 1;
   options.window = kFrames;
-  if (const char* env = std::getenv("SUBFLOW_BENCH_THREADS")) options.threads = std::atoi(env);
+  if (const char* env = std::getenv("SUBFLOW_BENCH_THREADS")) options.solver.threads = std::atoi(env);
   solver::RefinementResult result;
   for (auto _ : bench) {
-    result = solver::RefineStereo(s.dataset.cameras(), s.Gray(), solver::SilhouetteLoader(s.dataset, s.shape),
-                                  *s.shape.hierarchy, s.control, s.dataset.bounds(), options);
+    result = solver::RefineStereo(s.images, *s.shape.hierarchy, s.control, s.dataset.bounds(), options);
   }
   double solver_seconds = 0, iterations = 0, ncc = 0;
   for (const auto& level : result.levels) {

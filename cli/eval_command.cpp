@@ -17,7 +17,7 @@
 #include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "output/overwrite_guard.h"
-#include "solver/rigid_motion.h"
+#include "solver/rigid/rigid_motion.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
 

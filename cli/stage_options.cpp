@@ -1,5 +1,7 @@
 #include "cli/stage_options.h"
 
+#include "output/options_json.h"
+
 namespace subflow::cli {
 
 void AddDatasetAndOutput(CLI::App* sub, std::string* dataset, std::string* out, bool* overwrite) {
@@ -67,11 +69,18 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
                   "Frames a window shares with the next one, solved again there (at most --window - 1)")
       ->capture_default_str();
   sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
-  sub->add_option("--iterations", o->max_iterations, "Ceres iterations per round")->capture_default_str();
-  sub->add_option("--linear-solver", o->linear_solver,
-                  "Ceres linear solver: sparse_normal_cholesky, cgnr, iterative_schur, sparse_schur")
+  sub->add_option("--iterations", o->solver.max_iterations, "Ceres iterations per window and round")
       ->capture_default_str();
-  sub->add_option("--threads", o->threads, "Ceres threads (0 = all cores)")->capture_default_str();
+  sub->add_option_function<std::string>(
+         "--linear-solver",
+         [o](const std::string& name) {
+           if (!ceres::StringToLinearSolverType(name, &o->solver.linear_solver))
+             throw CLI::ValidationError("--linear-solver", "'" + name + "' is not a Ceres linear solver type "
+                                        "(e.g. sparse_normal_cholesky, sparse_schur, iterative_schur, cgnr, dense_qr)");
+         },
+         "Ceres linear solver type (ceres::LinearSolverType, any case)")
+      ->default_str(nlohmann::json(o->solver.linear_solver).get<std::string>());
+  sub->add_option("--threads", o->solver.threads, "Ceres threads (0 = all cores)")->capture_default_str();
   sub->add_option("--samples-per-pixel", o->samples_per_pixel,
                   "Surface samples per pixel² of a patch's finest view")->capture_default_str();
   sub->add_option("--max-cameras", o->max_cameras, "Best-facing cameras paired per patch")

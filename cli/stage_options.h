@@ -5,9 +5,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "solver/motion_init.h"
-#include "solver/shape_init.h"
-#include "solver/stereo_refinement.h"
+#include "solver/motion/motion_init.h"
+#include "solver/shape/shape_init.h"
+#include "solver/stereo/stereo_refinement.h"
 
 namespace subflow::cli {
 

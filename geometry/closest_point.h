@@ -70,9 +70,7 @@ class ClosestPointTree {
   // surface along its normal.
   RayHit NearestHitOnLine(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                           double max_abs_t = std::numeric_limits<double>::infinity()) const;
-  // Batch versions over rows of `origins` and `directions` (#Q×3 each), in parallel.
-  std::vector<RayHit> FirstHits(const Positions& origins, const Positions& directions,
-                                double max_t = std::numeric_limits<double>::infinity()) const;
+  // NearestHitOnLine over rows of `origins` and `directions` (#Q×3 each), in parallel.
   std::vector<RayHit> NearestHitsOnLines(
       const Positions& origins, const Positions& directions,
       double max_abs_t = std::numeric_limits<double>::infinity()) const;

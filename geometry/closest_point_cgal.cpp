@@ -186,17 +186,6 @@ RayHit ClosestPointTree::NearestHitOnLine(const Eigen::Vector3d& origin,
   return best;
 }
 
-std::vector<RayHit> ClosestPointTree::FirstHits(const Positions& origins,
-                                                const Positions& directions, double max_t) const {
-  SUBFLOW_CHECK(origins.rows() == directions.rows(), "one direction per origin");
-  std::vector<RayHit> result(static_cast<std::size_t>(origins.rows()));
-  ParallelRows(origins.rows(), [&](Eigen::Index i) {
-    result[i] = FirstHit(Eigen::Vector3d(origins.row(i).transpose()),
-                         Eigen::Vector3d(directions.row(i).transpose()), max_t);
-  });
-  return result;
-}
-
 std::vector<RayHit> ClosestPointTree::NearestHitsOnLines(const Positions& origins,
                                                          const Positions& directions,
                                                          double max_abs_t) const {

@@ -159,23 +159,6 @@ Positions LocalFrames::ToLocal(const Positions& world) const {
   return local;
 }
 
-LocalFrames FramesFromTangents(const Positions& t1, const Positions& t2) {
-  SUBFLOW_CHECK(t1.rows() == t2.rows(), "tangent counts differ");
-  const Eigen::Index count = t1.rows();
-  LocalFrames frames;
-  frames.normal.resize(count, 3);
-  frames.r.resize(count, 3);
-  frames.q.resize(count, 3);
-  Eigen::Vector3d n, r, q;
-  for (Eigen::Index v = 0; v < count; ++v) {
-    FrameFromTangents(t1.row(v).transpose(), t2.row(v).transpose(), &n, &r, &q);
-    frames.normal.row(v) = n.transpose();
-    frames.r.row(v) = r.transpose();
-    frames.q.row(v) = q.transpose();
-  }
-  return frames;
-}
-
 LocalFrames ComputeLocalFrames(const LoopHierarchy& hierarchy, int level,
                                const Positions& control_points) {
   SUBFLOW_CHECK(control_points.rows() == hierarchy.VertexCount(level),

@@ -40,9 +40,6 @@ struct LocalFrames {
 void FrameFromTangents(const Eigen::Vector3d& t1, const Eigen::Vector3d& t2,
                        Eigen::Vector3d* n, Eigen::Vector3d* r, Eigen::Vector3d* q);
 
-// Frames from two tangent vectors per vertex (rows of t1, t2, both #V×3).
-LocalFrames FramesFromTangents(const Positions& t1, const Positions& t2);
-
 // Frames of the limit surface at level `level`'s vertices for control points c
 // (#V(level)×3): tangents T1 c, T2 c of the hierarchy's limit tangent masks.
 LocalFrames ComputeLocalFrames(const LoopHierarchy& hierarchy, int level,

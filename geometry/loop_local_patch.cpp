@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "geometry/loop_box_spline.h"
+#include "geometry/loop_weights.h"
 
 namespace subflow::geometry::loop_patch {
 namespace {
@@ -126,9 +127,11 @@ class Refinement {
     const int n = static_cast<int>(ring.size());
     const bool boundary = patch_.boundary[i];
     if (boundary) {
-      terms_.insert(terms_.end(), {{c, 0.75}, {ring.front(), 0.125}, {ring.back(), 0.125}});
+      terms_.insert(terms_.end(), {{c, kLoopBoundaryEvenCenterWeight},
+                                   {ring.front(), kLoopBoundaryEvenNeighbourWeight},
+                                   {ring.back(), kLoopBoundaryEvenNeighbourWeight}});
     } else {
-      const double alpha = LoopRingWeight(n);
+      const double alpha = LoopAlpha(n);
       terms_.push_back({c, 1.0 - alpha});
       for (const int r : ring) terms_.push_back({r, alpha / n});
     }
@@ -136,10 +139,12 @@ class Refinement {
     for (int k = 0; k < n; ++k) {
       if (Has(c, ring[k])) continue;
       if (boundary && (k == 0 || k == n - 1))
-        terms_.insert(terms_.end(), {{c, 0.5}, {ring[k], 0.5}});
+        terms_.insert(terms_.end(), {{c, kLoopBoundaryOddWeight}, {ring[k], kLoopBoundaryOddWeight}});
       else
-        terms_.insert(terms_.end(), {{c, 0.375}, {ring[k], 0.375}, {ring[(k - 1 + n) % n], 0.125},
-                                     {ring[(k + 1) % n], 0.125}});
+        terms_.insert(terms_.end(), {{c, kLoopOddEdgeWeight},
+                                     {ring[k], kLoopOddEdgeWeight},
+                                     {ring[(k - 1 + n) % n], kLoopOddOppositeWeight},
+                                     {ring[(k + 1) % n], kLoopOddOppositeWeight}});
       Close(c, ring[k]);
     }
   }
@@ -151,11 +156,6 @@ class Refinement {
 };
 
 }  // namespace
-
-double LoopRingWeight(int valence) {
-  const double t = 3.0 + 2.0 * std::cos(2.0 * kPi / valence);
-  return 5.0 / 8.0 - t * t / 64.0;
-}
 
 LocalPatch PatchAroundFace(const MeshTopology& topology, int face) {
   LocalPatch patch;
@@ -328,12 +328,11 @@ void AddIrregularCornerWeights(const LocalPatch& patch, int corner, LocalWeights
   Eigen::VectorXd& du = weights->du;
   Eigen::VectorXd& dv = weights->dv;
   if (!patch.boundary[corner]) {
-    // Loop's limit mask: (1 − Kχ) c + χ Σ r_k, χ = 1/(3/(8β) + K), β = α(K)/K.
-    const double beta = LoopRingWeight(n) / n;
-    const double chi = 1.0 / (3.0 / (8.0 * beta) + n);
-    position[c] += 1.0 - n * chi;
+    // Loop's limit mask (loop_weights.h).
+    const LoopLimitWeights limit = LoopInteriorLimitWeights(n);
+    position[c] += limit.center;
     for (int k = 0; k < n; ++k) {
-      position[ring[k]] += chi;
+      position[ring[k]] += limit.ring;
       du[ring[k]] += 2.0 / n * std::cos(2.0 * kPi * (k - j) / n);
       dv[ring[k]] += 2.0 / n * std::cos(2.0 * kPi * (k - j - 1) / n);
     }
@@ -341,9 +340,9 @@ void AddIrregularCornerWeights(const LocalPatch& patch, int corner, LocalWeights
   }
   // Boundary: the cubic B-spline limit of the boundary curve.
   const int faces = n - 1;
-  position[c] += 2.0 / 3.0;
-  position[ring.front()] += 1.0 / 6.0;
-  position[ring.back()] += 1.0 / 6.0;
+  position[c] += kLoopBoundaryLimitCenterWeight;
+  position[ring.front()] += kLoopBoundaryLimitNeighbourWeight;
+  position[ring.back()] += kLoopBoundaryLimitNeighbourWeight;
   if (faces == 1) {
     du[ring[0]] += 1.0, du[c] -= 1.0;
     dv[ring[1]] += 1.0, dv[c] -= 1.0;

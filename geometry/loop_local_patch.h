@@ -64,9 +64,6 @@ struct LocalWeights {
         dv(Eigen::VectorXd::Zero(local_count)) {}
 };
 
-// Loop's even weight α(K) = 5/8 − (3 + 2 cos(2π/K))² / 64 (total weight of the ring).
-double LoopRingWeight(int valence);
-
 // The patch of `face` on the mesh's own level: support = its corners and their 1-rings.
 LocalPatch PatchAroundFace(const MeshTopology& topology, int face);
 

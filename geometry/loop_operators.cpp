@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "geometry/loop_weights.h"
 #include "geometry/point_stencil.h"
 
 namespace subflow::geometry {
@@ -115,11 +116,6 @@ Positions MultiplyPoints(const SparseMatrix& matrix, const Positions& x) {
   return y;
 }
 
-double LoopAlpha(int valence) {
-  const double c = 3.0 + 2.0 * std::cos(2.0 * kPi / valence);
-  return 5.0 / 8.0 - c * c / 64.0;
-}
-
 namespace {
 
 // Pattern keys of the stencils: rows with equal keys have equal weights.
@@ -137,9 +133,9 @@ void EmitRefinementRows(const MeshTopology& topology, Sink& sink) {
     CheckReferenced(topology, v);
     const IndexRange ring = topology.Ring(v);
     if (topology.IsBoundaryVertex(v)) {
-      sink.Add(v, 0.75);
-      sink.Add(ring.front(), 0.125);
-      sink.Add(ring.back(), 0.125);
+      sink.Add(v, kLoopBoundaryEvenCenterWeight);
+      sink.Add(ring.front(), kLoopBoundaryEvenNeighbourWeight);
+      sink.Add(ring.back(), kLoopBoundaryEvenNeighbourWeight);
       sink.EndRow(kBoundaryEvenPattern);
     } else {
       const int valence = ring.size();
@@ -152,15 +148,15 @@ void EmitRefinementRows(const MeshTopology& topology, Sink& sink) {
   for (int e = 0; e < topology.edge_count(); ++e) {
     const int a = topology.EdgeVertex(e, 0), b = topology.EdgeVertex(e, 1);
     if (topology.IsBoundaryEdge(e)) {
-      sink.Add(a, 0.5);
-      sink.Add(b, 0.5);
+      sink.Add(a, kLoopBoundaryOddWeight);
+      sink.Add(b, kLoopBoundaryOddWeight);
       sink.EndRow(kBoundaryOddPattern);
     } else {
       const int h = topology.EdgeHalfedge(e);
-      sink.Add(a, 0.375);
-      sink.Add(b, 0.375);
-      sink.Add(topology.HalfedgeOpposite(h), 0.125);
-      sink.Add(topology.HalfedgeOpposite(topology.HalfedgeTwin(h)), 0.125);
+      sink.Add(a, kLoopOddEdgeWeight);
+      sink.Add(b, kLoopOddEdgeWeight);
+      sink.Add(topology.HalfedgeOpposite(h), kLoopOddOppositeWeight);
+      sink.Add(topology.HalfedgeOpposite(topology.HalfedgeTwin(h)), kLoopOddOppositeWeight);
       sink.EndRow(kInteriorOddPattern);
     }
   }
@@ -324,15 +320,14 @@ SparseMatrix LoopLimitPositionMatrix(const MeshTopology& topology) {
     CheckReferenced(topology, v);
     const IndexRange ring = topology.Ring(v);
     if (topology.IsBoundaryVertex(v)) {
-      rows.Add(v, 2.0 / 3.0);
-      rows.Add(ring.front(), 1.0 / 6.0);
-      rows.Add(ring.back(), 1.0 / 6.0);
+      rows.Add(v, kLoopBoundaryLimitCenterWeight);
+      rows.Add(ring.front(), kLoopBoundaryLimitNeighbourWeight);
+      rows.Add(ring.back(), kLoopBoundaryLimitNeighbourWeight);
     } else {
       const int valence = ring.size();
-      const double beta = LoopAlpha(valence) / valence;
-      const double omega = 3.0 / (8.0 * beta);
-      rows.Add(v, omega / (omega + valence));
-      for (int r : ring) rows.Add(r, 1.0 / (omega + valence));
+      const LoopLimitWeights weights = LoopInteriorLimitWeights(valence);
+      rows.Add(v, weights.center);
+      for (int r : ring) rows.Add(r, weights.ring);
     }
     rows.EndRow();
   }

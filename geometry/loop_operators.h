@@ -28,14 +28,9 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 void MultiplyPoints(const SparseMatrix& matrix, const Positions& x, Positions* y);
 Positions MultiplyPoints(const SparseMatrix& matrix, const Positions& x);
 
-// Loop's original even weight (method eq. 9): α(K) = 5/8 − (3 + 2 cos(2π/K))² / 64.
-// The even rule (eq. 7–8) c⁺(v) = (a(K) c(v) + Σ_k c(r_k)) / (a(K) + K) with
-// a(K) = K(1 − α)/α is the same as c⁺(v) = (1 − α) c(v) + (α/K) Σ_k c(r_k).
-double LoopAlpha(int valence);
-
 // Refinement C (method eq. 10): (#V + #E) × #V. Row v < #V is the even vertex v, row
-// #V + e the odd vertex inserted on edge e (MeshTopology edge order). Rules, as in
-// CGAL::Subdivision_method_3::Loop_subdivision:
+// #V + e the odd vertex inserted on edge e (MeshTopology edge order). Rules (weights in
+// loop_weights.h), as in CGAL::Subdivision_method_3::Loop_subdivision:
 //   interior even  (1 − α(K)) c(v) + (α(K)/K) Σ_k c(r_k)
 //   boundary even  3/4 c(v) + 1/8 (c(r_0) + c(r_k))           (cubic B-spline crease)
 //   interior odd   3/8 (c(a) + c(b)) + 1/8 (c(o) + c(o'))   a, b the edge's ends,

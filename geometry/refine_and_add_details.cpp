@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "geometry/local_frames.h"
 #include "geometry/local_frames_kernels.h"
+#include "geometry/loop_weights.h"
 #include "geometry/point_stencil.h"
 #include "geometry/synthesis_plan.h"
 
@@ -286,7 +287,8 @@ SUBFLOW_KERNEL void GatherOddBlock(const SynthesisStep& step, int first, int siz
               x1 = Load<T>(c, col[4], k), x2 = Load<T>(c, col[5], k),
               x3 = Load<T>(c, col[6], k), x4 = Load<T>(c, col[7], k),
               ea = Load<T>(even, col[0], k), eb = Load<T>(even, col[1], k);
-      const T p = ((0.375 * pa + 0.375 * pb) + 0.125 * pp) + 0.125 * pq;
+      const T p = ((kLoopOddEdgeWeight * pa + kLoopOddEdgeWeight * pb) + kLoopOddOppositeWeight * pp) +
+                  kLoopOddOppositeWeight * pq;
       const T a = (ea - eb) + 0.25 * (pa - pb) + 0.0625 * ((x1 + x4) - (x2 + x3));
       const double h = 0.8660254037844386;  // √3/2
       const T b = h * (0.75 * (pq - pp) + 0.125 * ((x1 + x2) - (x3 + x4)));

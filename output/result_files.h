@@ -10,7 +10,7 @@
 
 #include "geometry/loop_hierarchy.h"
 #include "geometry/triangle_mesh.h"
-#include "solver/shape_init.h"
+#include "solver/shape/shape_init.h"
 
 namespace subflow::output {
 

@@ -1,17 +1,10 @@
 #include "solver/reconstruction.h"
 
-
-#include <opencv2/imgproc.hpp>
-#include <spdlog/spdlog.h>
-
 #include "core/error.h"
 #include "core/stopwatch.h"
-#include "vision/zbuffer.h"
+#include "vision/image_sequence.h"
 
 namespace subflow::solver {
-namespace {
-
-}  // namespace
 
 void ReconstructionOptions::Check() const {
   shape.Check();
@@ -21,25 +14,22 @@ void ReconstructionOptions::Check() const {
     ThrowError("reconstruction options", "retrack_weight", "must be in [0, 1]");
 }
 
+MotionInitOptions ReconstructionOptions::RetrackOptions() const {
+  MotionInitOptions retrack = motion;
+  retrack.hull_weight = retrack_weight;
+  return retrack;
+}
+
+std::string ReconstructionResult::BriefReport() const {
+  std::string lines = shape.BriefReport() + "\n" + motion.BriefReport();
+  if (refinement) lines += "\n" + refinement->BriefReport();
+  if (retrack) lines += "\nretrack: " + retrack->BriefReport();
+  return lines + "\n" + split.BriefReport();
+}
+
 geometry::Positions ReconstructionResult::Surface(int i) const {
   const geometry::LoopHierarchy& h = hierarchy();
   return h.LimitPositions(h.finest_level()) * control.at(i);
-}
-
-RefinementImageLoader SilhouetteLoader(const vision::Dataset& dataset, const ShapeInitResult& shape) {
-  const int first = shape.frames.empty() ? 0 : shape.frames.front().frame;
-  if (dataset.has_masks()) {
-    return [&dataset, first](int camera, int frame) {
-      const vision::Camera& cam = dataset.camera(camera);
-      const cv::Mat mask = dataset.Mask(camera, first + frame);
-      return cam.HasDistortion() ? cam.UndistortImage(mask, cv::INTER_NEAREST) : mask;
-    };
-  }
-  return [&dataset, &shape](int camera, int frame) {
-    const geometry::TriangleMesh& hull = shape.frames.at(frame).hull;
-    if (hull.F.rows() == 0) return cv::Mat();
-    return vision::ZBuffer(dataset.camera(camera), hull.V, hull.F).Mask();
-  };
 }
 
 ReconstructionResult Reconstruct(const vision::Dataset& dataset, const ReconstructionOptions& options,
@@ -54,46 +44,35 @@ ReconstructionResult Reconstruct(const vision::Dataset& dataset, const Reconstru
   const int finest = hierarchy.finest_level();
   result.first_frame = result.shape.frames.front().frame;
   const int frames = static_cast<int>(result.shape.frames.size());
+  std::vector<geometry::TriangleMesh> hulls;
+  for (const FrameShapeInit& frame : result.shape.frames) hulls.push_back(frame.hull);
+  const vision::ImageSequence images = vision::DatasetImages(dataset, result.first_frame, frames,
+                                                             options.shape.silhouettes.source, &hulls);
+  const int reference = result.shape.reference_frame - result.first_frame;
 
   // Motion initialization from the reference frame's fit, corrected towards every frame's.
   start.Restart();
   std::vector<geometry::Positions> fitted(frames);
   for (int i = 0; i < frames; ++i) fitted[i] = result.shape.frames[i].control.at(finest);
-  const int first = result.first_frame;
-  const GrayImageLoader gray = [&dataset, first](int camera, int frame) {
-    const vision::Camera& cam = dataset.camera(camera);
-    cv::Mat image = dataset.Gray(camera, first + frame);
-    return cam.HasDistortion() ? cam.UndistortImage(image) : image;
-  };
-  result.motion = InitializeMotion(dataset.cameras(), frames, gray, hierarchy, fitted,
-                                   result.shape.reference_frame - first, options.motion, progress);
+  result.motion = InitializeMotion(images, hierarchy, fitted, reference, options.motion, progress);
   result.motion_seconds = start.Seconds();
   result.control = result.motion.control;
 
   if (options.refine) {
     start.Restart();
-    result.refinement = RefineStereo(dataset.cameras(), gray, SilhouetteLoader(dataset, result.shape),
-                                     hierarchy, result.control, dataset.bounds(), options.refinement,
-                                     progress);
+    result.refinement = RefineStereo(images, hierarchy, result.control, dataset.bounds(), options.refinement, progress);
     result.control = result.refinement->control;
     result.refinement_seconds = start.Seconds();
     if (options.retrack) {
       start.Restart();
-      MotionInitOptions retrack = options.motion;
-      retrack.hull_weight = options.retrack_weight;
-      result.retrack = InitializeMotion(dataset.cameras(), frames, gray, hierarchy, result.control,
-                                        result.shape.reference_frame - first, retrack, progress);
+      result.retrack =
+          InitializeMotion(images, hierarchy, result.control, reference, options.RetrackOptions(), progress);
       result.control = result.retrack->control;
       result.retrack_seconds = start.Seconds();
     }
   }
 
-  start.Restart();
-  result.trajectory = geometry::AnalyzeTrajectory(hierarchy, result.control);
-  std::vector<geometry::Positions> bases;
-  for (const geometry::MultiresShape& shape : result.trajectory) bases.push_back(shape.base());
-  result.rigid = FitRigidMotions(bases);
-  result.analysis_seconds = start.Seconds();
+  result.split = SplitRigidMotion(hierarchy, result.control);
   return result;
 }
 

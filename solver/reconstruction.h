@@ -6,15 +6,15 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
-#include "geometry/loop_hierarchy.h"
-#include "geometry/multires_shape.h"
 #include "core/progress.h"
-#include "solver/motion_init.h"
-#include "solver/rigid_motion.h"
-#include "solver/shape_init.h"
-#include "solver/stereo_refinement.h"
+#include "geometry/loop_hierarchy.h"
+#include "solver/motion/motion_init.h"
+#include "solver/rigid/rigid_split.h"
+#include "solver/shape/shape_init.h"
+#include "solver/stereo/stereo_refinement.h"
 #include "vision/dataset.h"
 
 namespace subflow::solver {
@@ -35,6 +35,8 @@ struct ReconstructionOptions {
   double retrack_weight = 0.25;
 
   void Check() const;  // throws subflow::Error naming the field
+  // The options of the second motion pass: `motion` with hull_weight = retrack_weight.
+  MotionInitOptions RetrackOptions() const;
 };
 
 struct ReconstructionResult {
@@ -44,21 +46,17 @@ struct ReconstructionResult {
   std::optional<MotionInitResult> retrack;  // the second motion pass, when run
   int first_frame = 0;
   std::vector<geometry::Positions> control;  // final finest control points per frame
-  geometry::Trajectory trajectory;           // their multires analysis
-  std::vector<RigidMotion> rigid;            // per frame step, fitted on the base c⁰
-  double shape_seconds = 0, motion_seconds = 0, refinement_seconds = 0, retrack_seconds = 0,
-         analysis_seconds = 0;
+  RigidSplit split;                          // their multires analysis and rigid motions
+  double shape_seconds = 0, motion_seconds = 0, refinement_seconds = 0, retrack_seconds = 0;
+
+  // The stages' brief reports, one line each.
+  std::string BriefReport() const;
 
   const geometry::LoopHierarchy& hierarchy() const { return *shape.hierarchy; }
   // The output surface of frame i (0-based within the processed frames): the limit
   // positions of the finest level's vertices.
   geometry::Positions Surface(int i) const;
 };
-
-// The silhouettes the refinement keeps the outline on: the dataset's masks when it has
-// them (undistorted), else the visual hulls of shape initialization rendered into each
-// camera. Frames are indices within the processed range.
-RefinementImageLoader SilhouetteLoader(const vision::Dataset& dataset, const ShapeInitResult& shape);
 
 ReconstructionResult Reconstruct(const vision::Dataset& dataset, const ReconstructionOptions& options,
                                  Progress* progress = nullptr);

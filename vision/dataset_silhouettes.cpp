@@ -24,15 +24,13 @@ bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras) 
   return non_empty < min_cameras;
 }
 
-namespace {
-
-// The evidence of camera `camera` for EvidenceSource::kAuto: masks, else the background
-// image, else motion.
 EvidenceSource AutomaticSource(const Dataset& dataset, int camera) {
   return dataset.has_masks()                                    ? EvidenceSource::kMask
          : std::filesystem::exists(dataset.BackgroundPath(camera)) ? EvidenceSource::kBackground
                                                                    : EvidenceSource::kMotion;
 }
+
+namespace {
 
 // Whether camera `camera` would take motion evidence under options.source.
 bool UsesMotion(const Dataset& dataset, int camera, const SilhouetteOptions& options) {

@@ -252,6 +252,11 @@ Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const Estimat
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
                              const SilhouetteOptions& options, int open_radius = 0);
 
+// The evidence camera `camera` of `dataset` takes for EvidenceSource::kAuto: masks if the
+// dataset has them, else the background image if background/<camera>.png exists, else
+// motion. The one rule for shape initialization and the refinement's silhouettes.
+EvidenceSource AutomaticSource(const Dataset& dataset, int camera);
+
 // Whether `silhouettes` say nothing about where the object is: every camera uses motion
 // evidence and fewer than `min_cameras` of them have a non-empty silhouette (a frame of a
 // mask-less dataset in which nothing moves within the motion window).

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "output/options_json.h"
 #include "tests/test_support.h"
 #include "vision/synthetic_render.h"
 
@@ -71,7 +72,7 @@ TEST(HullCommand, ReportRecordsEverySilhouetteAndCarvingOptionAndTheValuesUsed) 
         "motion_window", "motion_threshold", "motion_method", "motion_min_threshold",
         "close_radius", "fill_holes", "min_region_pixels", "min_object_pixels"})
     EXPECT_TRUE(silhouettes.contains(field)) << "silhouettes." << field;
-  EXPECT_EQ(silhouettes.size(), 17u) << silhouettes.dump();
+  EXPECT_EQ(silhouettes.size(), nlohmann::json(vision::SilhouetteOptions{}).size()) << silhouettes.dump();
   EXPECT_EQ(silhouettes.at("background_threshold").get<double>(), 0.07);
   EXPECT_EQ(silhouettes.at("background_method").get<std::string>(), "triangle");
   EXPECT_EQ(silhouettes.at("motion_method").get<std::string>(), "otsu");
@@ -82,7 +83,7 @@ TEST(HullCommand, ReportRecordsEverySilhouetteAndCarvingOptionAndTheValuesUsed) 
         "connectivity", "min_component_fraction", "fill_cavities", "compute_silhouette_iou",
         "threads"})
     EXPECT_TRUE(carving.contains(field)) << "carving." << field;
-  EXPECT_EQ(carving.size(), 14u) << carving.dump();
+  EXPECT_EQ(carving.size(), nlohmann::json(vision::VoxelCarvingOptions{}).size()) << carving.dump();
   EXPECT_EQ(carving.at("min_cameras").get<int>(), 3);
   EXPECT_EQ(carving.at("max_misses").get<int>(), -1);  // automatic, as given
   EXPECT_EQ(carving.at("footprint_margin").get<double>(), 0.5);

@@ -64,6 +64,10 @@ TEST(ReconstructCommand, WritesTheOutputLayoutWithFlowProperties) {
   for (const char* stage : {"shape_init", "motion_init", "refinement", "retrack", "total"})
     EXPECT_GT(report["timings_seconds"][stage].get<double>(), 0.0) << stage;
   EXPECT_EQ(report["rigid_motion"].size(), 2u);
+  // Each motion pass records the options it ran with: the second one its own hull weight.
+  EXPECT_EQ(report["motion_init"]["options"]["hull_weight"], report["options"]["motion_init"]["hull_weight"]);
+  EXPECT_EQ(report["retrack"]["options"]["hull_weight"], report["options"]["retrack_weight"]);
+  EXPECT_NE(report["retrack"]["options"]["hull_weight"], report["motion_init"]["options"]["hull_weight"]);
   ASSERT_EQ(report["refinement"]["frames"].size(), 3u);
   for (const auto& frame : report["refinement"]["frames"]) {
     EXPECT_GT(frame["stereo_pairs"].get<int>(), 0);

@@ -1,4 +1,4 @@
-#include "solver/hierarchy_fit.h"
+#include "solver/shape/hierarchy_fit.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Motion initialization (method §4.2) on rendered images with known motion: one frame step
 // recovers a translation and a small rotation, and a sequence is propagated forward and
 // backward from a reference frame on one hierarchy with the rigid motion of every step.
-#include "solver/motion_init.h"
+#include "solver/motion/motion_init.h"
 
 #include <cmath>
 #include <cstdio>
@@ -10,7 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "solver/rigid_motion.h"
+#include "solver/rigid/rigid_motion.h"
+#include "solver/rigid/rigid_split.h"
 #include "tests/solver/motion_test_scene.h"
 
 namespace subflow::solver {
@@ -128,33 +129,33 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
                             truth.back().v).transpose();
     fitted.push_back(next);
   }
-  const GrayImageLoader loader = [&](int camera, int frame) { return images[frame][camera]; };
+  vision::ImageSequence images_of_frames{scene.cameras, 0, 3, [&](int camera, int frame) { return images[frame][camera]; }, {}};
   MotionInitOptions init;
-  const MotionInitResult result =
-      InitializeMotion(scene.cameras, 3, loader, scene.hierarchy, fitted, 1, init);
+  const MotionInitResult result = InitializeMotion(images_of_frames, scene.hierarchy, fitted, 1, init);
   ASSERT_EQ(result.control.size(), 3u);
-  ASSERT_EQ(result.trajectory.size(), 3u);
-  ASSERT_EQ(result.rigid.size(), 2u);
+  const RigidSplit split = SplitRigidMotion(scene.hierarchy, result.control);
+  ASSERT_EQ(split.trajectory.size(), 3u);
+  ASSERT_EQ(split.rigid.size(), 2u);
   EXPECT_EQ(result.frames[1].from_frame, -1);
   EXPECT_EQ(result.frames[0].from_frame, 1);
   EXPECT_EQ(result.frames[2].from_frame, 1);
   EXPECT_TRUE(result.frames[0].corrected && result.frames[2].corrected);
   for (int f = 0; f < 3; ++f) {
     EXPECT_EQ(result.control[f].rows(), scene.hierarchy.VertexCount(2));
-    EXPECT_EQ(result.trajectory[f].base().rows(), scene.hierarchy.VertexCount(0));
+    EXPECT_EQ(split.trajectory[f].base().rows(), scene.hierarchy.VertexCount(0));
   }
   for (int f = 0; f < 2; ++f) {
-    const double omega_error = (result.rigid[f].omega - truth[f].omega).norm();
-    const double v_error = (result.rigid[f].v - truth[f].v).norm() / truth[f].v.norm();
+    const double omega_error = (split.rigid[f].omega - truth[f].omega).norm();
+    const double v_error = (split.rigid[f].v - truth[f].v).norm() / truth[f].v.norm();
     std::printf("step %d→%d: rotation %.3f° (true %.3f°), |ω error| %.3f°, v error %.1f %%, "
                 "%.2f s\n",
-                f, f + 1, result.rigid[f].RotationAngle() / kDegree,
+                f, f + 1, split.rigid[f].RotationAngle() / kDegree,
                 truth[f].RotationAngle() / kDegree, omega_error / kDegree, 100 * v_error,
                 result.frames[f == 0 ? 0 : 2].step.seconds);
     EXPECT_LT(omega_error, 0.5 * kDegree);
     EXPECT_LT(v_error, 0.10);
   }
-  const FlowAnalysis flow = AnalyzeFlow(result.control, result.rigid);
+  const FlowAnalysis flow = AnalyzeFlow(result.control, split.rigid);
   const double mean_flow = flow.motion_energy.mean() / 2.0;
   const double mean_non_rigid = flow.non_rigid_energy.mean() / 2.0;
   std::printf("mean |flow| %.3f mm, mean |non-rigid flow| %.3f mm\n", 1e3 * mean_flow,
@@ -164,19 +165,19 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
 
 TEST(MotionInit, RejectsInconsistentInputs) {
   const MotionTestScene& scene = Scene();
-  const GrayImageLoader loader = [](int, int) { return cv::Mat(); };
+  const vision::ImageSequence images{scene.cameras, 0, 3, [](int, int) { return cv::Mat(); }, {}};
   const MotionInitOptions options;
-  EXPECT_THROW(InitializeMotion(scene.cameras, 3, loader, scene.hierarchy, {scene.control}, 3, options),
+  EXPECT_THROW(InitializeMotion(images, scene.hierarchy, {scene.control}, 3, options),
                Error);
-  EXPECT_THROW(InitializeMotion(scene.cameras, 3, loader, scene.hierarchy,
+  EXPECT_THROW(InitializeMotion(images, scene.hierarchy,
                                 {scene.control, scene.control}, 0, options),
                Error);
-  EXPECT_THROW(InitializeMotion(scene.cameras, 3, loader, scene.hierarchy,
+  EXPECT_THROW(InitializeMotion(images, scene.hierarchy,
                                 {Positions::Zero(5, 3)}, 0, options),
                Error);
   MotionInitOptions bad = options;
   bad.hull_weight = 1.5;
-  EXPECT_THROW(InitializeMotion(scene.cameras, 3, loader, scene.hierarchy, {scene.control}, 0, bad),
+  EXPECT_THROW(InitializeMotion(images, scene.hierarchy, {scene.control}, 0, bad),
                Error);
 }
 

@@ -14,7 +14,7 @@
 #include "geometry/loop_hierarchy.h"
 #include "geometry/triangle_mesh.h"
 #include "geometry/vertex_normals.h"
-#include "solver/surface_snapping.h"
+#include "solver/shape/surface_snapping.h"
 #include "vision/camera.h"
 #include "vision/camera_rig.h"
 #include "vision/synthetic_render.h"

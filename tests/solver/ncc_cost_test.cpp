@@ -1,4 +1,4 @@
-// The residuals of the stereo functional (solver/ncc_cost.h): the normalization and its
+// The residuals of the stereo functional (solver/stereo/ncc_cost.h): the normalization and its
 // derivative, the NCC identity ‖r‖² = W (2 − 2 NCC), analytic against numeric Jacobians
 // of the patch and silhouette costs, and the signed distance of a disk.
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "solver/ncc_cost.h"
+#include "solver/stereo/ncc_cost.h"
 #include "vision/camera_rig.h"
 
 namespace subflow::solver {

@@ -10,12 +10,12 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "solver/constraint_collinearity.h"
-#include "solver/image_derivatives.h"
-#include "solver/normal_flow_constraints.h"
-#include "solver/normal_flow_solver.h"
-#include "solver/sample_visibility.h"
-#include "solver/surface_sampling.h"
+#include "solver/motion/constraint_collinearity.h"
+#include "solver/observation/image_derivatives.h"
+#include "solver/motion/normal_flow_constraints.h"
+#include "solver/motion/normal_flow_solver.h"
+#include "solver/observation/sample_visibility.h"
+#include "solver/observation/surface_sampling.h"
 #include "tests/solver/motion_test_scene.h"
 
 namespace subflow::solver {

@@ -2,7 +2,7 @@
 // exact on rigid velocity fields, exact for finite rotations in the Cayley / midpoint
 // convention, and a non-rigid flow and motion energy that vanish for rigid sequences and
 // concentrate where a deformation is.
-#include "solver/rigid_motion.h"
+#include "solver/rigid/rigid_motion.h"
 
 #include <cmath>
 #include <random>

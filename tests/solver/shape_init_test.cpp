@@ -6,7 +6,7 @@
 //     silhouette, an object leaving the bounds) gives a warning naming the camera, frame
 //     or side, and the hulls are still computed from what remains; no evidence at all is
 //     an error that says so.
-#include "solver/shape_init.h"
+#include "solver/shape/shape_init.h"
 
 #include <cmath>
 #include <cstdio>

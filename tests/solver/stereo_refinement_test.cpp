@@ -1,4 +1,4 @@
-// Spatio-temporal stereo refinement (solver/stereo_refinement.h) on exact synthetic images:
+// Spatio-temporal stereo refinement (solver/stereo/stereo_refinement.h) on exact synthetic images:
 // the images are rendered from the limit surface of known control points, so the true
 // shape is representable. The true shape must be (nearly) a stationary point of the
 // functional, and a shape perturbed along its normals must move back towards it.
@@ -6,86 +6,28 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/closest_point.h"
 #include "core/error.h"
-#include "geometry/limit_tessellation.h"
-#include "geometry/local_frames.h"
-#include "geometry/multires_shape.h"
-#include "geometry/vertex_normals.h"
-#include "solver/stereo_refinement.h"
-#include "tests/solver/motion_test_scene.h"
+#include "solver/stereo/stereo_refinement.h"
+#include "tests/solver/refinement_test_scene.h"
 
 namespace subflow::solver {
 namespace {
 
 using geometry::Positions;
 
-struct RefinementScene {
-  testing::MotionTestScene scene = testing::MakeMotionTestScene(2, 8);
-  geometry::LimitTessellation tessellation;
-  geometry::SparseMatrix limit;
-  std::vector<cv::Mat> images;  // one per camera (a static scene: every frame the same)
-  std::vector<cv::Mat> masks;
-
-  RefinementScene() {
-    const int finest = scene.hierarchy.finest_level();
-    tessellation = geometry::TessellateLimitSurface(scene.hierarchy.Topology(finest), 4);
-    limit = geometry::LoopLimitEvaluator(scene.hierarchy.Topology(finest)).LimitMatrix(tessellation.samples);
-    const Positions V = limit * scene.control;
-    const vision::SyntheticRenderer renderer;
-    const Positions normals = geometry::VertexNormals(V, tessellation.faces);
-    for (const vision::Camera& camera : scene.cameras) {
-      const vision::RenderedView view = renderer.Render(camera, V, tessellation.faces, normals, V, false);
-      images.push_back(view.image);
-      masks.push_back(view.mask);
-    }
-  }
-  // RMS distance of the limit surface of `control` to the true limit surface.
-  double RmsDistanceToTruth(const Positions& control) const {
-    const geometry::ClosestPointTree tree({limit * scene.control, tessellation.faces}, "truth");
-    const Positions points = limit * control;
-    double sum = 0.0;
-    for (Eigen::Index i = 0; i < points.rows(); ++i)
-      sum += (tree.Closest(points.row(i).transpose()).point - points.row(i).transpose()).squaredNorm();
-    return std::sqrt(sum / static_cast<double>(points.rows()));
-  }
-  RefinementResult Refine(const Positions& control, int frames, StereoRefinementOptions options) const {
-    options.threads = 2;
-    vision::Bounds bounds{Eigen::Vector3d::Constant(-0.2), Eigen::Vector3d::Constant(0.2)};
-    return RefineStereo(
-        scene.cameras, [&](int camera, int) { return images[camera]; },
-        [&](int camera, int) { return masks[camera]; }, scene.hierarchy,
-        std::vector<Positions>(frames, control), bounds, options);
-  }
-};
-
-const RefinementScene& Scene() {
-  static const RefinementScene scene;
-  return scene;
-}
-
-// Smooth normal bumps on the level-1 details (about one pixel: 1.4 mm at 0.6 m).
-Positions Perturbed(const geometry::LoopHierarchy& hierarchy, const Positions& control, double amplitude) {
-  geometry::MultiresShape shape = geometry::MultiresShape::Analyze(hierarchy, control);
-  Positions& d1 = shape.Detail(1);
-  const Positions c1 = shape.Synthesize(hierarchy, 1);
-  for (Eigen::Index v = 0; v < d1.rows(); ++v) {
-    const Eigen::Vector3d p = c1.row(v).transpose().normalized();
-    d1(v, 0) += amplitude * std::sin(3.0 * p.x() + 1.0) * std::cos(2.0 * p.y() - 0.5);
-  }
-  return shape.Synthesize(hierarchy, hierarchy.finest_level());
-}
+using testing::Perturbed;
+using testing::Scene;
 
 StereoRefinementOptions TestOptions() {
   StereoRefinementOptions options;
   options.window = 2;
   options.rounds = 1;
-  options.max_iterations = 10;
+  options.solver.max_iterations = 10;
   return options;
 }
 
 TEST(StereoRefinement, TrueShapeIsNearlyStationary) {
-  const RefinementScene& scene = Scene();
+  const testing::RefinementScene& scene = Scene();
   const RefinementResult result = scene.Refine(scene.scene.control, 2, TestOptions());
   ASSERT_EQ(result.control.size(), 2u);
   // Starting at the truth, the surface stays within 0.2 px (1 px ≈ 1.4 mm at 0.6 m). It
@@ -100,7 +42,7 @@ TEST(StereoRefinement, TrueShapeIsNearlyStationary) {
 }
 
 TEST(StereoRefinement, PerturbedShapeMovesBackTowardsTheTruth) {
-  const RefinementScene& scene = Scene();
+  const testing::RefinementScene& scene = Scene();
   const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
   const double before = scene.RmsDistanceToTruth(perturbed);
   ASSERT_GT(before, 5e-4);
@@ -120,7 +62,7 @@ TEST(StereoRefinement, PerturbedShapeMovesBackTowardsTheTruth) {
 // Overlapping windows: with 2-frame windows sharing one frame, 3 frames take 2 windows and
 // the middle frame is solved in both; every frame is refined and moves back.
 TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
-  const RefinementScene& scene = Scene();
+  const testing::RefinementScene& scene = Scene();
   const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
   const double before = scene.RmsDistanceToTruth(perturbed);
   StereoRefinementOptions options = TestOptions();
@@ -134,7 +76,7 @@ TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
     EXPECT_LT(scene.RmsDistanceToTruth(result.control[f]), before) << "frame " << f;
   }
   options.window_overlap = 0;
-  options.max_iterations = 1;  // the window count does not depend on the solve
+  options.solver.max_iterations = 1;  // the window count does not depend on the solve
   EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 2);  // [0, 1], [2]
   options.window = 1;
   EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 3);
@@ -143,7 +85,7 @@ TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
 }
 
 TEST(StereoRefinement, RejectsBadInput) {
-  const RefinementScene& scene = Scene();
+  const testing::RefinementScene& scene = Scene();
   StereoRefinementOptions options = TestOptions();
   options.window = 0;
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
@@ -151,7 +93,10 @@ TEST(StereoRefinement, RejectsBadInput) {
   options.window_overlap = -1;
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
   options = TestOptions();
-  options.linear_solver = "magic";
+  options.solver.max_iterations = 0;
+  EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
+  options = TestOptions();
+  options.solver.function_tolerance = 0.0;
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
   Positions bad = scene.scene.control;
   bad(0, 0) = std::nan("");

@@ -1,0 +1,132 @@
+// Every options struct of the pipeline as JSON, field by field, for report.json (what was
+// run) and for reading recorded options back (stage reports). One line per struct lists
+// its fields beside the struct's namespace; tests/output/options_json_test.cpp counts the
+// fields of each struct (aggregate arity) against the keys written, so a field added to a
+// struct and forgotten here fails the build of the report's tests. Keys are the field
+// names; enums are written as the names the command line takes ("auto", "otsu",
+// "sparse_normal_cholesky"); automatic values are recorded as given (e.g. −1).
+#pragma once
+
+#include <algorithm>
+#include <cctype>
+#include <initializer_list>
+#include <string>
+
+#include <ceres/types.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "geometry/isosurface.h"
+#include "geometry/simplify.h"
+#include "solver/motion/motion_init.h"
+#include "solver/reconstruction.h"
+#include "solver/shape/shape_init.h"
+#include "solver/stereo/stereo_refinement.h"
+#include "vision/silhouettes.h"
+#include "vision/voxel_carving.h"
+
+namespace subflow::output {
+
+// The value of `values` whose name (ToString) is `text`; throws subflow::Error naming
+// `field` otherwise.
+template <typename Enum>
+Enum EnumFromName(const std::string& text, std::initializer_list<Enum> values, const std::string& field) {
+  std::string names;
+  for (Enum value : values) {
+    if (ToString(value) == text) return value;
+    names += (names.empty() ? "" : ", ") + ToString(value);
+  }
+  ThrowError("options", field, "'" + text + "' is not one of " + names);
+}
+
+}  // namespace subflow::output
+
+namespace ceres {
+
+// Ceres's own names, lower case: "sparse_normal_cholesky".
+inline void to_json(nlohmann::json& json, LinearSolverType type) {
+  std::string name = LinearSolverTypeToString(type);
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+  json = name;
+}
+inline void from_json(const nlohmann::json& json, LinearSolverType& type) {
+  if (!StringToLinearSolverType(json.get<std::string>(), &type))
+    subflow::ThrowError("options", "linear_solver", "'" + json.get<std::string>() + "' is not a Ceres linear solver");
+}
+
+}  // namespace ceres
+
+namespace subflow::vision {
+
+inline void to_json(nlohmann::json& json, EvidenceSource source) { json = ToString(source); }
+inline void from_json(const nlohmann::json& json, EvidenceSource& source) {
+  source = ParseEvidenceSource(json.get<std::string>());
+}
+inline void to_json(nlohmann::json& json, ThresholdMethod method) { json = ToString(method); }
+inline void from_json(const nlohmann::json& json, ThresholdMethod& method) {
+  method = output::EnumFromName(json.get<std::string>(), {ThresholdMethod::kOtsu, ThresholdMethod::kTriangle},
+                                "threshold method");
+}
+
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SilhouetteOptions, source, background_blur_sigma, background_threshold,
+                                   background_method, background_open_radius, background_min_threshold,
+                                   background_contour_fraction, motion_sigma, motion_lambda, motion_window,
+                                   motion_threshold, motion_method, motion_min_threshold, estimate_background,
+                                   background_estimate_min_frames, background_estimate_margin, close_radius,
+                                   fill_holes, min_region_pixels, min_object_pixels)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VoxelCarvingOptions, resolution, pixels_per_voxel, max_auto_resolution,
+                                   min_cameras, max_misses, evidence_threshold, footprint_margin, closing_radius,
+                                   opening_radius, connectivity, min_component_fraction, fill_cavities,
+                                   compute_silhouette_iou, threads)
+
+}  // namespace subflow::vision
+
+namespace subflow::geometry {
+
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(IsosurfaceOptions, iso_value, smoothing_sigma_voxels, padding_voxels,
+                                   facet_angle_degrees, facet_size_voxels, facet_distance_voxels,
+                                   max_vertex_count, random_seed)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_normal_change_degrees,
+                                   min_triangle_angle_degrees, max_valence, min_valence, flip_rounds,
+                                   max_flip_dihedral_degrees, check_self_intersections, max_attempts, retry_growth)
+
+}  // namespace subflow::geometry
+
+namespace subflow::solver {
+
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, carving, isosurface, simplify, fit, levels,
+                                   reference_frame, first_frame, frame_count)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,
+                                   tessellation_density)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(NormalFlowSolverOptions, smoothness, rigid_invariant_smoothness,
+                                   detail_damping, coarsest_level, finest_level, min_samples_per_face,
+                                   reweighting_iterations, robust_threshold, noise_floor, collinearity_pruning,
+                                   collinearity_min_cameras, cg_tolerance, cg_max_iterations)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solver, image_sigmas)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(WindowSolverOptions, linear_solver, max_iterations, threads, function_tolerance)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
+                                   normal_only_from_level, window, window_overlap, rounds, solver,
+                                   samples_per_pixel, min_density, max_density, max_cameras, min_samples,
+                                   image_sigma, ncc_epsilon, ncc_loss_scale, temporal_weight, silhouette_weight,
+                                   angle_weight_power, outline_margin, membrane_weight, temporal_smoothness,
+                                   damping, max_step, adaptive_threshold, visibility)
+
+// The stages under the names of their report sections.
+inline void to_json(nlohmann::json& json, const ReconstructionOptions& options) {
+  json = {{"shape_init", options.shape},   {"motion_init", options.motion},
+          {"refinement", options.refinement}, {"refine", options.refine},
+          {"retrack", options.retrack},    {"retrack_weight", options.retrack_weight}};
+}
+inline void from_json(const nlohmann::json& json, ReconstructionOptions& options) {
+  json.at("shape_init").get_to(options.shape);
+  json.at("motion_init").get_to(options.motion);
+  json.at("refinement").get_to(options.refinement);
+  json.at("refine").get_to(options.refine);
+  json.at("retrack").get_to(options.retrack);
+  json.at("retrack_weight").get_to(options.retrack_weight);
+}
+
+}  // namespace subflow::solver

@@ -1,0 +1,145 @@
+#include "solver/motion/motion_init.h"
+
+#include <cmath>
+#include <string>
+
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
+#include "core/error.h"
+#include "core/stopwatch.h"
+#include "geometry/closest_point.h"
+#include "geometry/mean_edge_length.h"
+#include "solver/shape/surface_snapping.h"
+
+namespace subflow::solver {
+
+using geometry::Positions;
+
+std::string MotionInitResult::BriefReport() const {
+  double zero = 0, estimated = 0;
+  int steps = 0;
+  for (const MotionFrameReport& frame : frames) {
+    if (frame.from_frame < 0) continue;
+    zero += frame.step.photometric_rms_zero;
+    estimated += frame.step.photometric_rms;
+    ++steps;
+  }
+  return fmt::format("motion init: {} frames from reference {}, photometric RMS {:.4f} (zero motion) → {:.4f}, {:.1f} s",
+                     frames.size(), reference_frame, steps ? zero / steps : 0.0, steps ? estimated / steps : 0.0,
+                     seconds);
+}
+
+void MotionInitOptions::Check() const {
+  step.Check();
+  if (!std::isfinite(hull_weight) || hull_weight < 0.0 || hull_weight > 1.0)
+    ThrowError("motion init", "hull_weight", "expected a value in [0, 1]");
+  if (!std::isfinite(hull_max_distance) || hull_max_distance < 0.0)
+    ThrowError("motion init", "hull_max_distance", "expected a finite value ≥ 0 (0 = automatic)");
+  if (hull_iterations < 1 || hull_iterations > 20)
+    ThrowError("motion init", "hull_iterations", "expected 1..20");
+}
+
+MotionInitResult InitializeMotion(const vision::ImageSequence& images,
+                                  const geometry::LoopHierarchy& hierarchy,
+                                  const std::vector<Positions>& initial_control,
+                                  int reference_frame, const MotionInitOptions& options,
+                                  Progress* progress) {
+  const Stopwatch start;
+  options.Check();
+  images.Check("motion init");
+  const std::vector<vision::Camera>& cameras = images.cameras;
+  const int frame_count = images.frame_count;
+  if (frame_count < 1) ThrowError("motion init", "frame count", "expected at least one frame");
+  if (reference_frame < 0 || reference_frame >= frame_count)
+    ThrowError("motion init", "reference frame",
+               std::to_string(reference_frame) + " is outside 0.." + std::to_string(frame_count - 1));
+  const bool per_frame = static_cast<int>(initial_control.size()) == frame_count && frame_count > 1;
+  if (!per_frame && initial_control.size() != 1)
+    ThrowError("motion init", "initial control points",
+               std::to_string(initial_control.size()) + " matrices, expected 1 (the reference "
+               "frame's) or one per frame (" + std::to_string(frame_count) + ")");
+  const int n = hierarchy.finest_level();
+  const Eigen::Index vertices = hierarchy.VertexCount(n);
+  const Positions& reference = per_frame ? initial_control[reference_frame] : initial_control[0];
+  if (reference.rows() != vertices)
+    ThrowError("motion init", "initial control points of the reference frame",
+               std::to_string(reference.rows()) + " rows, expected #V(n) = " +
+                   std::to_string(vertices));
+  for (std::size_t f = 0; per_frame && f < initial_control.size(); ++f)
+    if (initial_control[f].rows() != 0 && initial_control[f].rows() != vertices)
+      ThrowError("motion init", "initial control points of frame " + std::to_string(f),
+                 std::to_string(initial_control[f].rows()) + " rows, expected 0 or " +
+                     std::to_string(vertices));
+  auto fitted = [&](int frame) -> const Positions* {
+    if (!per_frame || initial_control[frame].rows() == 0) return nullptr;
+    return &initial_control[frame];
+  };
+
+  const MotionStepEstimator estimator(hierarchy, cameras, reference, options.step);
+  const double max_correction = options.hull_max_distance > 0.0
+                                    ? options.hull_max_distance
+                                    : 3.0 * geometry::MeanEdgeLength(hierarchy.Topology(n), reference);
+
+  MotionInitResult result;
+  result.reference_frame = reference_frame;
+  result.control.assign(frame_count, Positions());
+  result.control[reference_frame] = reference;
+  result.frames.resize(frame_count);
+  for (int f = 0; f < frame_count; ++f) result.frames[f].frame = f;
+
+  auto load = [&](int frame) {
+    std::vector<cv::Mat> loaded(cameras.size());
+    for (std::size_t k = 0; k < cameras.size(); ++k) loaded[k] = images.gray(static_cast<int>(k), frame);
+    return loaded;
+  };
+  int done = 0;
+  ProgressBegin(progress, "motion initialization", static_cast<std::size_t>(frame_count - 1));
+  auto propagate = [&](int from, int to, const std::vector<cv::Mat>& from_images,
+                       const std::vector<cv::Mat>& to_images) {
+    const MotionStep step = estimator.Estimate(result.control[from], from_images, to_images);
+    Positions control = result.control[from] + step.displacement;
+    MotionFrameReport& report = result.frames[to];
+    report.from_frame = from;
+    report.step = step.report;
+    if (const Positions* target = fitted(to); target && options.hull_weight > 0.0) {
+      const geometry::ClosestPointTree tree(estimator.visibility().Tessellation(*target),
+                                            "fitted surface of frame " + std::to_string(to));
+      SurfaceSnapOptions snap;
+      snap.weight = options.hull_weight;
+      snap.max_distance = max_correction;
+      snap.iterations = options.hull_iterations;
+      SurfaceSnapReport snap_report;
+      control = SnapToSurface(hierarchy, n, control, tree, snap, &snap_report);
+      report.corrected = true;
+      report.correction_rms_before = snap_report.rms_distance_before;
+      report.correction_rms_after = snap_report.rms_distance_after;
+    }
+    result.control[to] = std::move(control);
+    spdlog::debug("motion init: frame {} -> {}: {} constraints, {} pruned, photometric rms {:.4f} "
+                  "-> {:.4f}, mean |dc| {:.3g}, {:.2f} s",
+                  from, to, step.report.constraints, step.report.pruned,
+                  step.report.photometric_rms_zero, step.report.photometric_rms,
+                  step.report.mean_displacement, step.report.seconds);
+    ProgressUpdate(progress, static_cast<std::size_t>(++done));
+  };
+  const std::vector<cv::Mat> reference_images = load(reference_frame);
+  std::vector<cv::Mat> current = reference_images;
+  for (int f = reference_frame; f + 1 < frame_count; ++f) {
+    std::vector<cv::Mat> next = load(f + 1);
+    propagate(f, f + 1, current, next);
+    current = std::move(next);
+  }
+  current = reference_images;
+  for (int f = reference_frame; f > 0; --f) {
+    std::vector<cv::Mat> previous = load(f - 1);
+    propagate(f, f - 1, current, previous);
+    current = std::move(previous);
+  }
+  ProgressEnd(progress);
+
+  result.seconds = start.Seconds();
+  return result;
+}
+
+}  // namespace subflow::solver

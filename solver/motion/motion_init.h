@@ -1,0 +1,73 @@
+// Motion initialization over a sequence (method §4.2): trajectories of the control points
+// of ONE LoopHierarchy for every frame, from normal flow.
+//
+//   reference frame r: c(r) = the given fitted finest control points
+//   forward  f = r … F−2:  c(f+1) = c(f) + ∂c(f → f+1)   (MotionStepEstimator on the images
+//                                                         of frames f and f + 1)
+//   backward f = r … 1:    c(f−1) = c(f) + ∂c(f → f−1)
+//   after each step, when that frame has its own fitted control points (shape
+//   initialization on its visual hull), the normal component is corrected towards their
+//   limit surface (SnapToSurface, blend `hull_weight`, |distance| ≤ hull_max_distance):
+//   the hull bounds the drift along the normals; the tangential correspondence comes from
+//   the image motion alone.
+// Every frame keeps the hierarchy's connectivity: no re-meshing over time.
+//
+// The rigid / non-rigid split of the trajectories is a stage of its own
+// (solver/rigid/rigid_split.h: SplitRigidMotion).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/progress.h"
+#include "geometry/loop_hierarchy.h"
+#include "geometry/triangle_mesh.h"
+#include "solver/motion/motion_step.h"
+#include "vision/image_sequence.h"
+
+namespace subflow::solver {
+
+struct MotionInitOptions {
+  MotionStepOptions step;
+  // Normal correction towards each frame's own fitted surface, when given: blend weight in
+  // [0, 1] (0 = off), largest correction (world units; 0 = 3 × the mean finest edge
+  // length of the reference shape), snapping iterations.
+  double hull_weight = 0.5;
+  double hull_max_distance = 0.0;
+  int hull_iterations = 2;
+
+  void Check() const;  // throws subflow::Error naming the field
+};
+
+struct MotionFrameReport {
+  int frame = 0;
+  int from_frame = -1;  // the frame it was propagated from; −1 for the reference frame
+  MotionStepReport step;
+  bool corrected = false;           // normal correction applied
+  double correction_rms_before = 0.0;  // RMS normal distance to the frame's fitted surface
+  double correction_rms_after = 0.0;
+};
+
+struct MotionInitResult {
+  int reference_frame = 0;
+  std::vector<geometry::Positions> control;  // per frame: finest control points #V(n)×3
+  std::vector<MotionFrameReport> frames;     // per frame
+  double seconds = 0.0;
+
+  // One line: frames, reference, photometric RMS of zero motion → estimated, seconds.
+  std::string BriefReport() const;
+};
+
+// Trajectories for the frames of `images` (its gray images; frames and reference_frame
+// are window frames). `initial_control`: either one matrix (the reference frame's fitted
+// finest control points) or one per frame (images.frame_count entries; the reference
+// frame's must be non-empty, others may be empty = no fit for that frame, no correction
+// there). Throws subflow::Error on sizes, a reference frame out of range, or invalid
+// options.
+MotionInitResult InitializeMotion(const vision::ImageSequence& images,
+                                  const geometry::LoopHierarchy& hierarchy,
+                                  const std::vector<geometry::Positions>& initial_control,
+                                  int reference_frame, const MotionInitOptions& options,
+                                  Progress* progress = nullptr);
+
+}  // namespace subflow::solver

@@ -1,0 +1,111 @@
+#include "solver/motion/motion_step.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include <tbb/parallel_for.h>
+
+#include "core/error.h"
+
+namespace subflow::solver {
+namespace {
+
+using geometry::Positions;
+
+std::vector<SmoothedImage> SmoothAll(const std::vector<cv::Mat>& images, double sigma) {
+  std::vector<SmoothedImage> smoothed(images.size());
+  tbb::parallel_for(std::size_t{0}, images.size(),
+                    [&](std::size_t k) { smoothed[k] = SmoothImage(images[k], sigma); });
+  return smoothed;
+}
+
+double Rms(const Eigen::VectorXd& values) {
+  return values.size() > 0 ? std::sqrt(values.squaredNorm() / values.size()) : 0.0;
+}
+
+}  // namespace
+
+void MotionStepOptions::Check() const {
+  sampling.Check();
+  visibility.Check();
+  solver.Check();
+  if (image_sigmas.empty())
+    ThrowError("motion step", "image_sigmas", "expected at least one σ (one per pass)");
+  for (double sigma : image_sigmas)
+    if (!std::isfinite(sigma) || sigma < 0.0 || sigma > 20.0)
+      ThrowError("motion step", "image_sigmas", "expected values in [0, 20] pixels");
+}
+
+MotionStepEstimator::MotionStepEstimator(const geometry::LoopHierarchy& hierarchy,
+                                         const std::vector<vision::Camera>& cameras,
+                                         const Positions& reference_control,
+                                         const MotionStepOptions& options)
+    : hierarchy_(&hierarchy),
+      cameras_(cameras),
+      options_((options.Check(), options)),
+      samples_(SampleLimitSurface(hierarchy, hierarchy.finest_level(), reference_control, cameras,
+                                  options.sampling)),
+      visibility_(hierarchy, hierarchy.finest_level(), options.visibility),
+      solver_(hierarchy, samples_.limit, reference_control, options.solver) {
+  if (cameras.empty()) ThrowError("motion step", "cameras", "need at least one camera");
+}
+
+MotionStep MotionStepEstimator::Estimate(const Positions& control,
+                                         const std::vector<cv::Mat>& before,
+                                         const std::vector<cv::Mat>& after) const {
+  const auto start = std::chrono::steady_clock::now();
+  const int n = hierarchy_->finest_level();
+  if (control.rows() != hierarchy_->VertexCount(n))
+    ThrowError("motion step", "control points",
+               std::to_string(control.rows()) + " rows, expected #V(n) = " +
+                   std::to_string(hierarchy_->VertexCount(n)));
+  if (before.size() != cameras_.size() || after.size() != cameras_.size())
+    ThrowError("motion step", "images",
+               "expected one image per camera (" + std::to_string(cameras_.size()) + ") per frame");
+  for (std::size_t k = 0; k < cameras_.size(); ++k)
+    for (const cv::Mat* image : {&before[k], &after[k]})
+      if (image->cols != cameras_[k].width() || image->rows != cameras_[k].height())
+        ThrowError("motion step", "image of camera " + cameras_[k].name(),
+                   "size differs from the camera's " + std::to_string(cameras_[k].width()) + "×" +
+                       std::to_string(cameras_[k].height()));
+
+  const Positions positions = samples_.SamplePositions(control);
+  const SampleVisibility visibility =
+      visibility_.Compute(cameras_, control, positions, samples_.SampleNormals(control));
+
+  MotionStep step;
+  step.report.samples = samples_.size();
+  step.report.visible_samples = visibility.SamplesSeenBy(1);
+  step.report.multi_view_samples = visibility.SamplesSeenBy(2);
+  step.displacement = Positions::Zero(control.rows(), 3);
+  Positions sample_motion;  // empty: zero guess on the first pass
+  const int passes = static_cast<int>(options_.image_sigmas.size());
+  std::vector<SmoothedImage> smoothed_before, smoothed_after;
+  for (int pass = 0; pass < passes; ++pass) {
+    smoothed_before = SmoothAll(before, options_.image_sigmas[pass]);
+    smoothed_after = SmoothAll(after, options_.image_sigmas[pass]);
+    const NormalFlowConstraints constraints = BuildStepConstraints(
+        cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility);
+    if (pass == passes - 1) {
+      // Photometric error of zero motion at the finest σ.
+      step.report.photometric_rms_zero = Rms(StepPhotometricDifferences(
+          cameras_, smoothed_before, smoothed_after, positions, Positions(), visibility));
+    }
+    step.solution = solver_.Solve(constraints, control, pass > 0 ? &step.solution : nullptr);
+    step.displacement = step.solution.displacement;
+    sample_motion = solver_.SampleMotion(step.displacement);
+    step.report.cg_iterations += step.solution.cg_iterations;
+    step.report.constraints = constraints.size();
+    step.report.pruned = step.solution.pruned;
+    step.report.collinearity_pruned = step.solution.collinearity_pruned;
+  }
+  step.report.photometric_rms = Rms(StepPhotometricDifferences(
+      cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility));
+  step.report.mean_displacement = step.displacement.rowwise().norm().mean();
+  step.report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return step;
+}
+
+}  // namespace subflow::solver

@@ -1,0 +1,452 @@
+#include "solver/motion/normal_flow_solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "core/error.h"
+#include "geometry/local_frames.h"
+#include "geometry/loop_operators.h"
+#include "solver/motion/conjugate_gradient.h"
+#include "solver/motion/constraint_collinearity.h"
+
+namespace subflow::solver {
+namespace {
+
+using geometry::Positions;
+using Sparse = Eigen::SparseMatrix<double>;
+using VectorMap = Eigen::Map<Eigen::VectorXd>;
+using ConstVectorMap = Eigen::Map<const Eigen::VectorXd>;
+
+// Limit weights are O(1) (a row of L sums to 1); what the products L P_i leave of the
+// finest stencil's other ancestors cancels to ~1e-16.
+constexpr double kCancelledWeight = 1e-12;
+
+// A ⊗ I3 for a scalar sparse matrix A: entry (r, c) becomes the 3×3 block at (3r, 3c).
+template <typename Matrix>
+Sparse Kron3(const Matrix& A) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(3 * static_cast<std::size_t>(A.nonZeros()));
+  for (int outer = 0; outer < A.outerSize(); ++outer)
+    for (typename Matrix::InnerIterator it(A, outer); it; ++it)
+      for (int a = 0; a < 3; ++a)
+        triplets.emplace_back(3 * static_cast<int>(it.row()) + a, 3 * static_cast<int>(it.col()) + a,
+                              it.value());
+  Sparse result(3 * A.rows(), 3 * A.cols());
+  result.setFromTriplets(triplets.begin(), triplets.end());
+  return result;
+}
+
+}  // namespace
+
+void NormalFlowSolverOptions::Check() const {
+  auto finite_nonnegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!finite_nonnegative(smoothness))
+    ThrowError("normal flow solver", "smoothness", "expected a finite value ≥ 0");
+  if (!finite_nonnegative(detail_damping))
+    ThrowError("normal flow solver", "detail_damping", "expected a finite value ≥ 0");
+  if (coarsest_level < 0)
+    ThrowError("normal flow solver", "coarsest_level", "expected ≥ 0");
+  if (finest_level >= 0 && finest_level < coarsest_level)
+    ThrowError("normal flow solver", "finest_level", "expected −1 or ≥ coarsest_level");
+  if (reweighting_iterations < 0 || reweighting_iterations > 50)
+    ThrowError("normal flow solver", "reweighting_iterations", "expected 0..50");
+  if (!std::isfinite(robust_threshold) || robust_threshold <= 0.0)
+    ThrowError("normal flow solver", "robust_threshold", "expected a finite value > 0");
+  if (!finite_nonnegative(noise_floor))
+    ThrowError("normal flow solver", "noise_floor", "expected a finite value ≥ 0 (intensity)");
+  if (collinearity_min_cameras < 3)
+    ThrowError("normal flow solver", "collinearity_min_cameras",
+               "expected ≥ 3 (two planes always intersect in a line)");
+  if (!std::isfinite(cg_tolerance) || cg_tolerance <= 0.0 || cg_tolerance >= 1.0)
+    ThrowError("normal flow solver", "cg_tolerance", "expected a value in (0, 1)");
+  if (!std::isfinite(min_samples_per_face) || min_samples_per_face < 0.0)
+    ThrowError("normal flow solver", "min_samples_per_face", "expected a finite value ≥ 0");
+  if (cg_max_iterations < 1)
+    ThrowError("normal flow solver", "cg_max_iterations", "expected ≥ 1");
+}
+
+NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
+                                   const geometry::SparseMatrix& sample_limit,
+                                   const Positions& reference_control,
+                                   const NormalFlowSolverOptions& options)
+    : hierarchy_(&hierarchy), options_(options) {
+  options_.Check();
+  n_ = hierarchy.finest_level();
+  lo_ = options_.coarsest_level;
+  hi_ = options_.finest_level;
+  if (hi_ < 0) {
+    hi_ = lo_;
+    while (hi_ < n_ && static_cast<double>(sample_limit.rows()) / hierarchy.FaceCount(hi_ + 1) >=
+                           options_.min_samples_per_face)
+      ++hi_;
+  }
+  if (hi_ > n_ || lo_ > n_)
+    ThrowError("normal flow solver", "levels",
+               "coarsest/finest level beyond the hierarchy's finest level " + std::to_string(n_));
+  const int vertices = hierarchy.VertexCount(n_);
+  if (sample_limit.cols() != vertices)
+    ThrowError("normal flow solver", "sample limit matrix",
+               std::to_string(sample_limit.cols()) + " columns, expected #V(n) = " +
+                   std::to_string(vertices));
+  if (reference_control.rows() != vertices)
+    ThrowError("normal flow solver", "reference control points",
+               std::to_string(reference_control.rows()) + " rows, expected " +
+                   std::to_string(vertices));
+  limit_ = sample_limit;
+  limit_.makeCompressed();
+
+  // Prolongations P_i = C(n−1)⋯C(i), Laplacian Gram matrices, length scales.
+  prolongation3_.resize(n_ + 1);
+  level_limit_.resize(n_ + 1);
+  refinement3_.resize(n_ + 1);
+  smoothness3_.resize(n_ + 1);
+  regularizer3_.resize(n_ + 1);
+  length_ratio4_.assign(n_ + 1, 0.0);
+  geometry::SparseMatrix P(vertices, vertices);
+  P.setIdentity();
+  const Eigen::RowVector3d centroid = reference_control.colwise().mean();
+  const double radius =
+      std::sqrt((reference_control.rowwise() - centroid).rowwise().squaredNorm().mean());
+  const geometry::MeshTopology& finest = hierarchy.Topology(n_);
+  double edge_sum = 0.0;
+  for (int e = 0; e < finest.edge_count(); ++e)
+    edge_sum += (reference_control.row(finest.EdgeVertex(e, 0)) -
+                 reference_control.row(finest.EdgeVertex(e, 1))).norm();
+  const double finest_edge = edge_sum / std::max(1, finest.edge_count());
+  if (!(radius > 0.0) || !(finest_edge > 0.0))
+    ThrowError("normal flow solver", "reference control points", "are degenerate (zero size)");
+  for (int level = n_; level >= lo_; --level) {
+    if (level < n_) P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
+    if (level < hi_) refinement3_[level] = Kron3(hierarchy.Refinement(level));
+    if (level == hi_) stencils_ = MakeStencils(geometry::SparseMatrix(limit_ * P));
+    if (level <= hi_) {
+      if (level == hi_) {
+        level_limit_[level] = stencils_.limit;
+      } else {
+        level_limit_[level] = level_limit_[level + 1] * hierarchy.Refinement(level);
+        level_limit_[level].prune(1.0, kCancelledWeight);
+        level_limit_[level].makeCompressed();
+      }
+      prolongation3_[level] = Kron3(P);
+      const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(hierarchy.Topology(level));
+      smoothness3_[level] = Kron3(geometry::SparseMatrix(U.transpose() * U));
+      length_ratio4_[level] = std::pow(radius / (finest_edge * std::ldexp(1.0, n_ - level)), 4);
+      Sparse identity(smoothness3_[level].rows(), smoothness3_[level].cols());
+      identity.setIdentity();
+      regularizer3_[level] = options_.smoothness * length_ratio4_[level] * smoothness3_[level] +
+                             (level == lo_ ? 1e-9 : options_.detail_damping) * identity;
+      regularizer3_[level].makeCompressed();
+    }
+  }
+}
+
+NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
+    const geometry::SparseMatrix& limit) {
+  SampleStencils stencils;
+  stencils.limit = limit.pruned(1.0, kCancelledWeight);
+  stencils.limit.makeCompressed();
+  const geometry::SparseMatrix& L = stencils.limit;
+  // Pattern of Lᵀ L (all-ones values: no cancellation), inner indices sorted (a transposed
+  // copy sorts them; the lookups below bisect).
+  Sparse ones = L;
+  for (int k = 0; k < ones.outerSize(); ++k)
+    for (Sparse::InnerIterator it(ones, k); it; ++it) it.valueRef() = 1.0;
+  stencils.pattern = Sparse(ones.transpose() * ones);
+  const Sparse pattern_transposed = stencils.pattern.transpose();
+  stencils.pattern = pattern_transposed.transpose();
+  stencils.pattern.makeCompressed();
+  const int* outer = stencils.pattern.outerIndexPtr();
+  const int* inner = stencils.pattern.innerIndexPtr();
+  auto entry = [&](int row, int column) {
+    const int* first = inner + outer[column];
+    const int* last = inner + outer[column + 1];
+    const int* found = std::lower_bound(first, last, row);
+    SUBFLOW_CHECK(found != last && *found == row, "LᵀL pattern misses a pair");
+    return static_cast<int>(found - inner);
+  };
+  const int vertices = static_cast<int>(stencils.pattern.cols());
+  stencils.mirror.resize(static_cast<std::size_t>(stencils.pattern.nonZeros()));
+  tbb::parallel_for(0, vertices, [&](int column) {
+    for (int e = outer[column]; e < outer[column + 1]; ++e) stencils.mirror[e] = entry(column, inner[e]);
+  });
+  const int samples = static_cast<int>(L.rows());
+  stencils.sample_pair_offset.assign(samples + 1, 0);
+  for (int s = 0; s < samples; ++s) {
+    const int k = L.outerIndexPtr()[s + 1] - L.outerIndexPtr()[s];
+    stencils.sample_pair_offset[s + 1] = stencils.sample_pair_offset[s] + k * (k + 1) / 2;
+  }
+  stencils.pair_entry.resize(stencils.sample_pair_offset.back());
+  tbb::parallel_for(0, samples, [&](int s) {
+    const int begin = L.outerIndexPtr()[s], k = L.outerIndexPtr()[s + 1] - begin;
+    const int* columns = L.innerIndexPtr() + begin;
+    int* pairs = stencils.pair_entry.data() + stencils.sample_pair_offset[s];
+    for (int p = 0; p < k; ++p)
+      for (int q = p; q < k; ++q)
+        *pairs++ = entry(std::min(columns[p], columns[q]), std::max(columns[p], columns[q]));
+  });
+  return stencils;
+}
+
+NormalFlowSolver::Sparse NormalFlowSolver::DataMatrix(
+    const SampleStencils& stencils, const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M) {
+  const Sparse& pattern = stencils.pattern;
+  const geometry::SparseMatrix& L = stencils.limit;
+  const int vertices = static_cast<int>(pattern.cols());
+  const int samples = static_cast<int>(L.rows());
+  const std::size_t entries = static_cast<std::size_t>(pattern.nonZeros());
+  // Block (a, b) of N = Σ_s L_sᵀ L_s ⊗ M_s is Σ_s l_sa l_sb M_s: symmetric, and equal to
+  // block (b, a). Only the upper pattern entries (row ≤ column) accumulate, 6 values each.
+  auto add_samples = [&](int first, int last, double* sums) {
+    for (int s = first; s < last; ++s) {
+      const double* m6 = M.row(s).data();
+      if (m6[0] == 0.0 && m6[3] == 0.0 && m6[5] == 0.0) continue;
+      const int begin = L.outerIndexPtr()[s], k = L.outerIndexPtr()[s + 1] - begin;
+      const double* l = L.valuePtr() + begin;
+      const int* pairs = stencils.pair_entry.data() + stencils.sample_pair_offset[s];
+      for (int p = 0; p < k; ++p)
+        for (int q = p; q < k; ++q) {
+          const double w = l[p] * l[q];
+          double* sum = sums + 6 * static_cast<std::size_t>(*pairs++);
+          for (int i = 0; i < 6; ++i) sum[i] += w * m6[i];
+        }
+    }
+  };
+  // Parallel over a fixed split of the samples, each part into its own sums, added in
+  // part order (deterministic). The parts are few: their sums (6 per pattern entry of
+  // level hi, not the finest level) cost less than the scatter they parallelize.
+  const int part_count = std::clamp(samples / 8192, 1, 4);
+  std::vector<std::vector<double>> partial(part_count);
+  tbb::parallel_for(0, part_count, [&](int part) {
+    partial[part].assign(6 * entries, 0.0);
+    add_samples(static_cast<int>(static_cast<long>(samples) * part / part_count),
+                static_cast<int>(static_cast<long>(samples) * (part + 1) / part_count),
+                partial[part].data());
+  });
+  std::vector<double>& sums = partial[0];
+  for (int part = 1; part < part_count; ++part)
+    for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += partial[part][i];
+
+  // Interleaved (unknown 3v + axis): the block of pattern entry e (column j with m entries,
+  // its t-th) holds column 3j + b at values 9 outer[j] + 3 m b + 3 t + a (row 3 inner[e] + a).
+  const int* outer = pattern.outerIndexPtr();
+  const int* inner = pattern.innerIndexPtr();
+  Sparse N(3 * vertices, 3 * vertices);
+  N.resizeNonZeros(static_cast<Eigen::Index>(9 * entries));
+  int* N_outer = N.outerIndexPtr();
+  int* N_inner = N.innerIndexPtr();
+  double* values = N.valuePtr();
+  constexpr int kSym[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+  tbb::parallel_for(tbb::blocked_range<int>(0, vertices, 256), [&](const tbb::blocked_range<int>& range) {
+    for (int j = range.begin(); j < range.end(); ++j) {
+      const int m = outer[j + 1] - outer[j];
+      for (int b = 0; b < 3; ++b) {
+        const int start = 9 * outer[j] + 3 * m * b;
+        N_outer[3 * j + b] = start;
+        for (int t = 0; t < m; ++t) {
+          const int e = outer[j] + t;
+          const double* sum = sums.data() + 6 * static_cast<std::size_t>(inner[e] <= j ? e : stencils.mirror[e]);
+          for (int a = 0; a < 3; ++a) {
+            N_inner[start + 3 * t + a] = 3 * inner[e] + a;
+            values[start + 3 * t + a] = sum[kSym[a][b]];
+          }
+        }
+      }
+    }
+  });
+  N_outer[3 * vertices] = static_cast<int>(9 * entries);
+  return N;
+}
+
+Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
+  SUBFLOW_CHECK(displacement.rows() == limit_.cols(), "displacement of another level");
+  return limit_ * displacement;
+}
+
+std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
+                                                  const Positions& previous) const {
+  std::vector<Positions> rigid_part(n_ + 1);
+  if (!options_.rigid_invariant_smoothness || previous.rows() != control.rows()) return rigid_part;
+  Positions midpoints = control + 0.5 * previous;
+  const RigidMotion rigid = FitRigidMotion(midpoints, previous);
+  for (int level = n_; level >= lo_; --level) {
+    if (level <= hi_) rigid_part[level] = rigid.Velocity(midpoints);
+    if (level > lo_) midpoints = hierarchy_->Coarsening(level) * midpoints;
+  }
+  return rigid_part;
+}
+
+void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
+                                   const Eigen::VectorXd& weights,
+                                   const std::vector<Positions>& rigid_part,
+                                   NormalFlowSolution* solution,
+                                   Positions* sample_motion_out) const {
+  const int samples = static_cast<int>(limit_.rows());
+  const int vertices = static_cast<int>(limit_.cols());
+  // Per-sample aggregates: M_s = Σ w g gᵀ (6 unique entries), h_s = Σ w b g.
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> M =
+      Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>::Zero(samples, 6);
+  Positions h = Positions::Zero(samples, 3);
+  for (int c = 0; c < constraints.size(); ++c) {
+    const double w = weights(c);
+    if (w == 0.0) continue;
+    const Eigen::RowVector3d g = constraints.gradient.row(c);
+    const int s = constraints.sample[c];
+    M.row(s) += w * Eigen::Matrix<double, 1, 6>(g(0) * g(0), g(0) * g(1), g(0) * g(2),
+                                                g(1) * g(1), g(1) * g(2), g(2) * g(2));
+    h.row(s) += (w * constraints.rhs(c)) * g;
+  }
+  solution->displacement = Positions::Zero(vertices, 3);
+  VectorMap D(solution->displacement.data(), 3 * vertices);
+  Positions sample_motion = Positions::Zero(samples, 3);  // L D
+  solution->level_motion.resize(n_ + 1);
+  solution->levels.clear();
+  Positions coarse_motion = Positions::Zero(hierarchy_->VertexCount(lo_), 3);  // W_i
+  // Data matrices of the levels: assembled on level hi, carried to the coarser ones one
+  // refinement step at a time, P_iᵀ N P_i = C(i)ᵀ (P_{i+1}ᵀ N P_{i+1}) C(i).
+  std::vector<Sparse> data(n_ + 1);
+  data[hi_] = DataMatrix(stencils_, M);
+  for (int level = hi_ - 1; level >= lo_; --level)
+    data[level] = Sparse(refinement3_[level].transpose() * Sparse(data[level + 1] * refinement3_[level]));
+  for (int level = lo_; level <= hi_; ++level) {
+    const int unknowns = 3 * hierarchy_->VertexCount(level);
+    const Sparse& P3 = prolongation3_[level];
+    const geometry::SparseMatrix& level_limit = level_limit_[level];
+    Sparse A = std::move(data[level]);
+    LevelSolveReport report;
+    report.level = level;
+    report.unknowns = unknowns;
+    report.data_stiffness = A.diagonal().sum() / unknowns;
+    Positions& delta = solution->level_motion[level];
+    if (delta.rows() != hierarchy_->VertexCount(level))
+      delta = Positions::Zero(hierarchy_->VertexCount(level), 3);
+    VectorMap x(delta.data(), unknowns);
+    if (report.data_stiffness > 0.0) {
+      report.smoothness_weight =
+          options_.smoothness * report.data_stiffness * length_ratio4_[level];
+      Positions smooth_about = coarse_motion;  // W_i − ρ_i
+      if (rigid_part[level].rows() == smooth_about.rows()) smooth_about -= rigid_part[level];
+      const ConstVectorMap W(smooth_about.data(), unknowns);
+      // Data part of the right-hand side: P_iᵀ (Lᵀ h − Lᵀ M L D) = L_iᵀ (h_s − M_s (L D)_s).
+      Positions sample_rhs(samples, 3);
+      tbb::parallel_for(tbb::blocked_range<int>(0, samples, 4096),
+                        [&](const tbb::blocked_range<int>& range) {
+        for (int s = range.begin(); s < range.end(); ++s) {
+          const double* m6 = M.row(s).data();
+          const double u0 = sample_motion(s, 0), u1 = sample_motion(s, 1), u2 = sample_motion(s, 2);
+          sample_rhs(s, 0) = h(s, 0) - (m6[0] * u0 + m6[1] * u1 + m6[2] * u2);
+          sample_rhs(s, 1) = h(s, 1) - (m6[1] * u0 + m6[3] * u1 + m6[4] * u2);
+          sample_rhs(s, 2) = h(s, 2) - (m6[2] * u0 + m6[4] * u1 + m6[5] * u2);
+        }
+      });
+      const Positions data_rhs = level_limit.transpose() * sample_rhs;
+      const Eigen::VectorXd rhs = ConstVectorMap(data_rhs.data(), unknowns) -
+                                  report.smoothness_weight * (smoothness3_[level] * W);
+      // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
+      A += report.data_stiffness * regularizer3_[level];
+      A.makeCompressed();
+      Eigen::VectorXd solution_vector = x;
+      const ConjugateGradientResult cg = SolveConjugateGradient(
+          A, rhs, options_.cg_tolerance, options_.cg_max_iterations, &solution_vector);
+      x = solution_vector;
+      report.cg_iterations = cg.iterations;
+      report.cg_error = cg.relative_residual;
+    } else {
+      x.setZero();
+    }
+    D += P3 * x;
+    sample_motion += level_limit * delta;
+    solution->cg_iterations += report.cg_iterations;
+    solution->levels.push_back(report);
+    if (level < hi_)
+      coarse_motion = hierarchy_->Refinement(level) * Positions(coarse_motion + delta);
+  }
+  *sample_motion_out = std::move(sample_motion);
+}
+
+NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constraints,
+                                           const Positions& control,
+                                           const NormalFlowSolution* warm_start) const {
+  const int samples = static_cast<int>(limit_.rows());
+  if (control.rows() != limit_.cols())
+    ThrowError("normal flow solver", "control points",
+               std::to_string(control.rows()) + " rows, expected #V(n) = " +
+                   std::to_string(limit_.cols()));
+  for (int c = 0; c < constraints.size(); ++c)
+    if (constraints.sample[c] < 0 || constraints.sample[c] >= samples)
+      ThrowError("normal flow solver", "constraint " + std::to_string(c),
+                 "sample index " + std::to_string(constraints.sample[c]) + " out of range");
+  NormalFlowSolution solution;
+  if (warm_start) solution.level_motion = warm_start->level_motion;
+  solution.collinearity_weights = Eigen::VectorXd::Ones(constraints.size());
+  if (options_.collinearity_pruning) {
+    CollinearityOptions collinearity;
+    collinearity.min_cameras = options_.collinearity_min_cameras;
+    collinearity.threshold = options_.robust_threshold;
+    collinearity.noise_floor = options_.noise_floor;
+    const CollinearityResult tested = CollinearityWeights(constraints, samples, collinearity);
+    solution.collinearity_weights = tested.weights;
+    solution.collinearity_pruned = tested.pruned;
+  }
+  Eigen::VectorXd weights = solution.collinearity_weights;
+  Eigen::VectorXd residual;
+  Positions previous = warm_start ? warm_start->displacement : Positions();
+  Positions sample_motion;
+  for (int pass = 0; pass <= options_.reweighting_iterations; ++pass) {
+    SolveLevels(constraints, weights, RigidPart(control, previous), &solution, &sample_motion);
+    previous = solution.displacement;
+    residual = constraints.Residuals(sample_motion);
+    if (pass == options_.reweighting_iterations) break;
+    std::vector<double> active;
+    for (int c = 0; c < constraints.size(); ++c)
+      if (solution.collinearity_weights(c) > 0.0) active.push_back(residual(c));
+    const double sigma = RobustScale(active, options_.noise_floor);
+    if (!(sigma > 0.0)) break;
+    solution.robust_scale = sigma;
+    for (int c = 0; c < constraints.size(); ++c)
+      weights(c) = solution.collinearity_weights(c) *
+                   TukeyWeight(residual(c) / (options_.robust_threshold * sigma));
+  }
+  solution.weights = weights;
+  solution.rigid = FitRigidMotion(control + 0.5 * solution.displacement, solution.displacement);
+  double sum_zero = 0.0, sum = 0.0;
+  int kept = 0;
+  for (int c = 0; c < constraints.size(); ++c) {
+    sum_zero += constraints.rhs(c) * constraints.rhs(c);
+    if (weights(c) > 0.0) {
+      sum += residual(c) * residual(c);
+      ++kept;
+    } else {
+      ++solution.pruned;
+    }
+  }
+  solution.rms_residual_zero = constraints.size() > 0 ? std::sqrt(sum_zero / constraints.size()) : 0.0;
+  solution.rms_residual = kept > 0 ? std::sqrt(sum / kept) : 0.0;
+  return solution;
+}
+
+std::vector<Positions> LocalDetailMotion(const geometry::LoopHierarchy& hierarchy,
+                                         const Positions& finest_control,
+                                         const NormalFlowSolution& solution, int coarsest_level) {
+  const int n = hierarchy.finest_level();
+  SUBFLOW_CHECK(finest_control.rows() == hierarchy.VertexCount(n), "finest control points expected");
+  std::vector<Positions> local(n + 1);
+  Positions fine = finest_control;
+  for (int level = n; level >= 1; --level) {
+    Positions coarse = hierarchy.Coarsening(level) * fine;
+    if (level > coarsest_level && level < static_cast<int>(solution.level_motion.size()) &&
+        solution.level_motion[level].rows() == hierarchy.VertexCount(level)) {
+      const Positions predicted = hierarchy.Refinement(level - 1) * coarse;
+      local[level] =
+          geometry::ComputeLocalFrames(hierarchy, level, predicted).ToLocal(solution.level_motion[level]);
+    }
+    fine = std::move(coarse);
+  }
+  return local;
+}
+
+}  // namespace subflow::solver

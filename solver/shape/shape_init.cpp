@@ -1,0 +1,177 @@
+#include "solver/shape/shape_init.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
+#include "core/stopwatch.h"
+#include "geometry/closest_point.h"
+#include "core/error.h"
+
+namespace subflow::solver {
+namespace {
+
+// Frames without evidence take the hull and carving figures of the nearest frame with
+// evidence (the earlier one on a tie), with a warning; an error when no frame has any.
+void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std::vector<bool>& has_evidence,
+                                      int min_cameras, std::vector<FrameShapeInit>* frames) {
+  const int count = static_cast<int>(frames->size());
+  if (std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end())
+    ThrowError(dataset.directory(),
+               "frames " + std::to_string(frames->front().frame) + ".." + std::to_string(frames->back().frame),
+               "no masks, no background, and no motion: cannot find the object (motion evidence in fewer than " +
+                   std::to_string(min_cameras) + " camera(s) in every frame)");
+  for (int i = 0; i < count; ++i) {
+    if (has_evidence[i]) continue;
+    int source = -1;
+    for (int d = 1; source < 0; ++d) {
+      if (i - d >= 0 && has_evidence[i - d]) source = i - d;
+      else if (i + d < count && has_evidence[i + d]) source = i + d;
+    }
+    FrameShapeInit& frame = (*frames)[i];
+    const FrameShapeInit& taken = (*frames)[source];
+    frame.hull_from_frame = taken.frame;
+    frame.carving = taken.carving;
+    frame.carving.frame = frame.frame;
+    frame.carving.warnings.clear();
+    frame.isosurface = taken.isosurface;
+    frame.hull = taken.hull;
+    const std::string warning =
+        "frame " + std::to_string(frame.frame) + ": no masks, no background, and motion evidence in fewer than " +
+        std::to_string(min_cameras) + " camera(s) (nothing moves): hull of frame " + std::to_string(taken.frame) +
+        " used";
+    spdlog::warn("{}", warning);
+    frame.carving.warnings.push_back(warning);
+  }
+}
+
+}  // namespace
+
+std::string ShapeInitResult::BriefReport() const {
+  double iou = 0, seconds = estimate_background_seconds + simplify_seconds;
+  int with_iou = 0;
+  for (const FrameShapeInit& frame : frames) {
+    if (std::isfinite(frame.carving.mean_silhouette_iou)) iou += frame.carving.mean_silhouette_iou, ++with_iou;
+    seconds += frame.carve_seconds + frame.isosurface_seconds + frame.fit_seconds;
+  }
+  const int levels = hierarchy ? hierarchy->finest_level() : 0;
+  return fmt::format("shape init: {} frames ({}–{}), reference {}, base mesh {} vertices / {} faces, {} levels "
+                     "(finest {} faces), mean silhouette IoU {:.4f}, {:.1f} s",
+                     frames.size(), frames.empty() ? 0 : frames.front().frame, frames.empty() ? 0 : frames.back().frame,
+                     reference_frame, base_mesh.vertex_count(), base_mesh.face_count(), levels,
+                     hierarchy ? hierarchy->FaceCount(levels) : 0, with_iou ? iou / with_iou : 0.0, seconds);
+}
+
+void ShapeInitOptions::Check() const {
+  carving.Check();
+  isosurface.Check();
+  simplify.Check();
+  fit.Check();
+  if (levels < 0 || levels > 6) ThrowError("shape init options", "levels", "expected 0..6");
+  if (first_frame < 0) ThrowError("shape init options", "first_frame", "expected ≥ 0");
+  if (frame_count == 0 || frame_count < -1)
+    ThrowError("shape init options", "frame_count", "expected > 0, or −1 for all frames");
+}
+
+ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitOptions& options,
+                                Progress* progress) {
+  options.Check();
+  const int available = dataset.frame_count() - options.first_frame;
+  if (available <= 0)
+    ThrowError(dataset.directory(), "first_frame",
+               "frame " + std::to_string(options.first_frame) + " is past the last frame (" +
+                   std::to_string(dataset.frame_count()) + " frames)");
+  const int count = options.frame_count < 0 ? available : std::min(options.frame_count, available);
+  const int first = options.first_frame;
+  const int reference = options.reference_frame < 0 ? first + count / 2 : options.reference_frame;
+  if (reference < first || reference >= first + count)
+    ThrowError(dataset.directory(), "reference_frame",
+               "frame " + std::to_string(reference) + " is outside the frames processed [" +
+                   std::to_string(first) + ", " + std::to_string(first + count) + ")");
+
+  ShapeInitResult result;
+  result.reference_frame = reference;
+  result.frames.resize(count);
+
+  // Without masks and background images: backgrounds estimated from the video.
+  Stopwatch estimate_start;
+  result.estimated_backgrounds = vision::EstimateBackgrounds(dataset, options.silhouettes);
+  result.estimate_background_seconds = estimate_start.Seconds();
+  for (const vision::EstimatedBackground& estimated : result.estimated_backgrounds)
+    if (estimated.valid()) {
+      spdlog::info("no masks, no background: background estimated from {} frames per camera ({:.1f} s)",
+                   estimated.frames, result.estimate_background_seconds);
+      break;
+    }
+
+  // Visual hull of every frame with evidence.
+  std::vector<bool> has_evidence(count, false);
+  ProgressBegin(progress, "visual hull", count);
+  for (int i = 0; i < count; ++i) {
+    FrameShapeInit& frame = result.frames[i];
+    frame.frame = frame.hull_from_frame = first + i;
+    Stopwatch start;
+    const std::vector<vision::Silhouette> silhouettes =
+        vision::ComputeFrameEvidence(dataset, frame.frame, options.silhouettes, &result.estimated_backgrounds);
+    has_evidence[i] = !vision::LacksEvidence(silhouettes, options.carving.min_cameras);
+    if (has_evidence[i]) {
+      frame.carving = vision::CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), options.carving,
+                                          frame.frame);
+      frame.carve_seconds = start.Seconds();
+      start.Restart();
+      frame.hull = geometry::ExtractIsosurface(frame.carving.occupancy, options.isosurface, &frame.isosurface,
+                                               "occupancy of frame " + vision::FrameName(frame.frame));
+      frame.isosurface_seconds = start.Seconds();
+      frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
+    }
+    ProgressUpdate(progress, i + 1);
+  }
+  ProgressEnd(progress);
+  for (vision::EstimatedBackground& estimated : result.estimated_backgrounds)  // memory: keep the figures
+    estimated.image.release(), estimated.known.release();
+  TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, options.carving.min_cameras, &result.frames);
+
+  // Base mesh and hierarchy from the reference frame.
+  Stopwatch start;
+  const FrameShapeInit& reference_frame = result.frames[reference - first];
+  result.base_mesh = geometry::SimplifyMesh(reference_frame.hull, options.simplify,
+                                            &result.simplify,
+                                            "visual hull of frame " + vision::FrameName(reference));
+  result.simplify_seconds = start.Seconds();
+  result.hierarchy = std::make_shared<const geometry::LoopHierarchy>(
+      result.base_mesh.F, result.base_mesh.vertex_count(), options.levels, "base mesh");
+  spdlog::info("base mesh: {} vertices, {} faces; {} levels, finest {} faces",
+               result.base_mesh.vertex_count(), result.base_mesh.face_count(), options.levels,
+               result.hierarchy->FaceCount(options.levels));
+
+  // Fit the hierarchy to every frame's hull, outwards from the reference frame.
+  ProgressBegin(progress, "fit subdivision surface", count);
+  std::vector<int> order{reference - first};
+  for (int d = 1; d < count; ++d) {
+    if (reference - first - d >= 0) order.push_back(reference - first - d);
+    if (reference - first + d < count) order.push_back(reference - first + d);
+  }
+  int done = 0;
+  for (int i : order) {
+    FrameShapeInit& frame = result.frames[i];
+    start.Restart();
+    const int neighbour = i < reference - first ? i + 1 : i - 1;
+    const geometry::Positions& initial_base =
+        i == reference - first ? result.base_mesh.V : result.frames[neighbour].control.front();
+    const geometry::ClosestPointTree hull_tree(frame.hull, "visual hull of frame " +
+                                                               vision::FrameName(frame.frame));
+    frame.control = FitHierarchyToSurface(*result.hierarchy, initial_base, hull_tree,
+                                          options.fit, &frame.fit);
+    frame.shape = geometry::MultiresShape::Analyze(*result.hierarchy, frame.control.back());
+    frame.fit_seconds = start.Seconds();
+    ProgressUpdate(progress, ++done);
+  }
+  ProgressEnd(progress);
+  return result;
+}
+
+}  // namespace subflow::solver

@@ -1,0 +1,91 @@
+// Shape initialization (method §4.1): from multi-view video to a time-varying shape on
+// ONE subdivision connectivity.
+//
+//   per frame f:  silhouettes (mask | background difference | motion evidence, eq. 23)
+//                 → evidence voxels → 3D morphology → occupancy        (vision/voxel_carving.h)
+//                 → iso-surface: the visual hull H_f                     (geometry/isosurface.h)
+//   reference frame r:  T0 = simplification of H_r (Garland–Heckbert)   (geometry/simplify.h)
+//                 → LoopHierarchy of T0 with `levels` levels
+//   every frame:  control points of levels 0..n fitted to H_f along limit normals
+//                 (solver/shape/hierarchy_fit.h), frames visited outwards from r so that each
+//                 starts from its neighbour's fitted base; MultiresShape by analysis.
+//
+// Snapping along normals only moves points across the surface: vertices of different
+// frames correspond only approximately (tangential drift). Motion initialization
+// (normal flow) is what makes them trajectories.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geometry/isosurface.h"
+#include "geometry/loop_hierarchy.h"
+#include "geometry/multires_shape.h"
+#include "core/progress.h"
+#include "geometry/simplify.h"
+#include "solver/shape/hierarchy_fit.h"
+#include "vision/dataset.h"
+#include "vision/silhouettes.h"
+#include "vision/voxel_carving.h"
+
+namespace subflow::solver {
+
+struct ShapeInitOptions {
+  vision::SilhouetteOptions silhouettes;
+  vision::VoxelCarvingOptions carving;
+  geometry::IsosurfaceOptions isosurface;
+  geometry::SimplifyOptions simplify;  // target_face_count = faces of the base mesh T0
+  HierarchyFitOptions fit;
+  // Subdivision levels above the base mesh (the hierarchy has levels 0..levels).
+  int levels = 3;
+  // Frame whose visual hull gives the base connectivity; −1 = the middle frame.
+  int reference_frame = -1;
+  // Frames [first_frame, first_frame + frame_count); frame_count −1 = to the end.
+  int first_frame = 0;
+  int frame_count = -1;
+
+  void Check() const;  // throws subflow::Error naming the field
+};
+
+struct FrameShapeInit {
+  int frame = 0;
+  // The frame whose evidence gave the hull: `frame` itself, or for a frame without any
+  // evidence (vision::LacksEvidence: no masks, no background, nothing moves) the nearest
+  // frame with evidence (the earlier one on a tie), whose hull and carving figures are
+  // taken, with a warning in carving.warnings.
+  int hull_from_frame = 0;
+  vision::CarvingResult carving;             // figures; its occupancy volume is released
+  geometry::IsosurfaceSummary isosurface;
+  geometry::TriangleMesh hull;               // the visual-hull iso-surface H_f
+  std::vector<geometry::Positions> control;  // fitted control points, levels 0..n
+  std::vector<LevelFitSummary> fit;          // per level
+  geometry::MultiresShape shape;             // analysis of control.back()
+  double carve_seconds = 0, isosurface_seconds = 0, fit_seconds = 0;
+};
+
+struct ShapeInitResult {
+  int reference_frame = 0;
+  geometry::TriangleMesh base_mesh;  // T0 (level 0 at the reference frame, before fitting)
+  geometry::SimplifySummary simplify;
+  std::shared_ptr<const geometry::LoopHierarchy> hierarchy;
+  std::vector<FrameShapeInit> frames;  // in frame order
+  // Per camera, the background estimated from the video (vision::EstimateBackgrounds;
+  // the figures only, images released) for cameras without masks and background image;
+  // empty when none was estimated.
+  std::vector<vision::EstimatedBackground> estimated_backgrounds;
+  double estimate_background_seconds = 0;
+  double simplify_seconds = 0;
+
+  // One line: frames, base mesh, levels, mean silhouette IoU, seconds.
+  std::string BriefReport() const;
+};
+
+// Runs the whole stage on `dataset`. Throws subflow::Error on bad input (see the
+// vision/geometry stages), and when no frame has any evidence of the object; warnings
+// (cameras excluded, object touching the bounds, a frame without evidence) are logged
+// and kept in each frame's carving result.
+ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitOptions& options,
+                                Progress* progress = nullptr);
+
+}  // namespace subflow::solver

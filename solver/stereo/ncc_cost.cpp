@@ -1,0 +1,303 @@
+#include "solver/stereo/ncc_cost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+
+namespace subflow::solver {
+namespace {
+
+// Intensity and gradient at a pixel; outside the image the pixel is clamped to the border
+// and the gradient is zero (the residual stays defined, its derivative vanishes there).
+double SampleClamped(const SmoothedImage& image, const Eigen::Vector2d& pixel,
+                     Eigen::Vector2d* gradient) {
+  double intensity = 0.0;
+  if (SampleImage(image, pixel, &intensity, gradient)) return intensity;
+  const Eigen::Vector2d clamped(std::clamp(pixel.x(), 0.0, image.width() - 1.0 - 1e-6),
+                                std::clamp(pixel.y(), 0.0, image.height() - 1.0 - 1e-6));
+  Eigen::Vector2d unused;
+  SampleImage(image, clamped, &intensity, &unused);
+  gradient->setZero();
+  return intensity;
+}
+
+// X = X⁰ + Σ_j w_j B_j e_j for one sample (row `k` of the stencil).
+Eigen::Vector3d SamplePosition(const Eigen::Vector3d& base, const double* weights, int support,
+                               const std::vector<Eigen::Matrix3d>& basis, int dof,
+                               double const* const* parameters, int first_block) {
+  Eigen::Vector3d X = base;
+  for (int j = 0; j < support; ++j) {
+    if (weights[j] == 0.0) continue;
+    const double* e = parameters[first_block + j];
+    for (int d = 0; d < dof; ++d) X += weights[j] * e[d] * basis[j].col(d);
+  }
+  return X;
+}
+
+}  // namespace
+
+void SampleView(const PatchView& view, const PatchStencil& stencil, int dof,
+                double const* const* parameters, Eigen::VectorXd* intensities,
+                RowJacobian* jacobian, const std::vector<int>* rows) {
+  const int m = static_cast<int>(stencil.rows());
+  const int support = static_cast<int>(stencil.cols());
+  // Displacement of each support vertex, B_j e_j (support × 3).
+  thread_local Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> moved;
+  moved.resize(support, 3);
+  for (int j = 0; j < support; ++j) {
+    const double* e = parameters[view.first_block + j];
+    Eigen::Vector3d delta = view.basis[j].col(0) * e[0];
+    for (int d = 1; d < dof; ++d) delta += view.basis[j].col(d) * e[d];
+    moved.row(j) = delta.transpose();
+  }
+  intensities->setZero(m);
+  if (jacobian) {
+    jacobian->resize(m, support * dof);
+    if (!rows) jacobian->setZero();
+    else for (int k : *rows) jacobian->row(k).setZero();
+  }
+  auto sample = [&](int k) {
+    const Eigen::Vector3d X = view.base[k] + (stencil.row(k) * moved).transpose();
+    Eigen::Vector2d gradient;
+    (*intensities)(k) = SampleClamped(*view.image, view.camera->ProjectUndistorted(X), &gradient);
+    if (!jacobian || gradient.isZero()) return;
+    const Eigen::RowVector3d g = gradient.transpose() * view.camera->ProjectionJacobian(X);
+    double* row = jacobian->row(k).data();
+    const double* weights = stencil.row(k).data();
+    for (int j = 0; j < support; ++j) {
+      const double w = weights[j];
+      if (w == 0.0) continue;
+      const Eigen::Matrix3d& B = view.basis[j];
+      for (int d = 0; d < dof; ++d) row[j * dof + d] = w * (g(0) * B(0, d) + g(1) * B(1, d) + g(2) * B(2, d));
+    }
+  };
+  if (rows) {
+    for (int k : *rows) sample(k);
+  } else {
+    for (int k = 0; k < m; ++k) sample(k);
+  }
+}
+
+namespace {
+
+// In-place form of NormalizeIntensities: x becomes x̂, J becomes ∂x̂/∂θ (no allocation
+// once the thread's scratch vectors have grown to size).
+void NormalizeInPlace(Eigen::VectorXd& x, double epsilon, RowJacobian* J) {
+  const double m = static_cast<double>(x.size());
+  x.array() -= x.mean();
+  const double sigma = std::sqrt(x.squaredNorm() + m * epsilon * epsilon);
+  if (!(sigma > 0.0)) {  // constant vector and ε = 0: no correlation information
+    x.setZero();
+    if (J) J->setZero();
+    return;
+  }
+  x /= sigma;
+  if (!J) return;
+  thread_local Eigen::RowVectorXd column_means, projection;
+  column_means.noalias() = J->colwise().sum() / m;
+  projection.noalias() = x.transpose() * *J;
+  J->rowwise() -= column_means;
+  J->noalias() -= x * projection;
+  *J /= sigma;
+}
+
+}  // namespace
+
+Eigen::VectorXd NormalizeIntensities(const Eigen::VectorXd& x, double epsilon,
+                                     RowJacobian* d_normalized) {
+  Eigen::VectorXd normalized = x;
+  NormalizeInPlace(normalized, epsilon, d_normalized);
+  return normalized;
+}
+
+PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, std::vector<PatchView> views,
+                                           std::vector<CorrelationPair> pairs, int block_count,
+                                           int dof, double epsilon)
+    : stencil_(std::move(stencil)),
+      views_(std::move(views)),
+      pairs_(std::move(pairs)),
+      dof_(dof),
+      epsilon_(epsilon) {
+  const auto support = static_cast<std::size_t>(stencil_.cols());
+  const auto m = static_cast<std::size_t>(stencil_.rows());
+  if (dof != 1 && dof != 3) ThrowError("PatchCorrelationCost", "dof", "must be 1 or 3");
+  if (!(epsilon >= 0.0)) ThrowError("PatchCorrelationCost", "epsilon", "must be finite and ≥ 0");
+  if (pairs_.empty()) ThrowError("PatchCorrelationCost", "pairs", "needs at least one pair");
+  for (const PatchView& view : views_) {
+    if (!view.image || !view.camera || view.base.size() != m || view.basis.size() != support ||
+        view.first_block < 0 || view.first_block + static_cast<int>(support) > block_count)
+      ThrowError("PatchCorrelationCost", "view",
+                 "needs an image, a camera, one position per sample and one basis per support "
+                 "vertex, with its blocks inside the block count");
+  }
+  std::vector<std::vector<char>> needed(views_.size(), std::vector<char>(m, 0));
+  int residuals = 0;
+  for (const CorrelationPair& pair : pairs_) {
+    const int views = static_cast<int>(views_.size());
+    if (pair.a < 0 || pair.a >= views || pair.b < 0 || pair.b >= views || pair.a == pair.b ||
+        pair.rows.size() < 2 || !(pair.weight >= 0.0))
+      ThrowError("PatchCorrelationCost", "pair",
+                 "needs two different views, at least 2 sample rows and a weight ≥ 0");
+    for (int row : pair.rows) {
+      if (row < 0 || row >= static_cast<int>(m))
+        ThrowError("PatchCorrelationCost", "pair rows", "sample index out of range");
+      needed[pair.a][row] = needed[pair.b][row] = 1;
+    }
+    residuals += static_cast<int>(pair.rows.size());
+  }
+  view_rows_.resize(views_.size());
+  for (std::size_t v = 0; v < views_.size(); ++v)
+    for (std::size_t k = 0; k < m; ++k)
+      if (needed[v][k]) view_rows_[v].push_back(static_cast<int>(k));
+  set_num_residuals(residuals);
+  for (int i = 0; i < block_count; ++i) mutable_parameter_block_sizes()->push_back(dof);
+}
+
+PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, PatchView a, PatchView b,
+                                           int block_count, int dof, double weight, double epsilon)
+    : PatchCorrelationCost(
+          stencil, {std::move(a), std::move(b)},
+          {CorrelationPair{0, 1,
+                           [&] {
+                             std::vector<int> rows(static_cast<std::size_t>(stencil.rows()));
+                             for (std::size_t k = 0; k < rows.size(); ++k) rows[k] = static_cast<int>(k);
+                             return rows;
+                           }(),
+                           weight}},
+          block_count, dof, epsilon) {}
+
+bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* residuals,
+                                    double** jacobians) const {
+  const int columns = static_cast<int>(stencil_.cols()) * dof_;
+  // Per-thread scratch: Ceres evaluates blocks concurrently, and this is the hot path.
+  thread_local std::vector<Eigen::VectorXd> intensities;
+  thread_local std::vector<RowJacobian> view_jacobians;
+  thread_local Eigen::VectorXd xa, xb;
+  thread_local RowJacobian ja, jb;
+  if (intensities.size() < views_.size()) {
+    intensities.resize(views_.size());
+    view_jacobians.resize(views_.size());
+  }
+  for (std::size_t v = 0; v < views_.size(); ++v)
+    SampleView(views_[v], stencil_, dof_, parameters, &intensities[v],
+               jacobians ? &view_jacobians[v] : nullptr, &view_rows_[v]);
+
+  const int blocks = static_cast<int>(parameter_block_sizes().size());
+  if (jacobians)
+    for (int block = 0; block < blocks; ++block)
+      if (jacobians[block])
+        std::fill(jacobians[block], jacobians[block] + num_residuals() * dof_, 0.0);
+
+  int offset = 0;
+  for (const CorrelationPair& pair : pairs_) {
+    const int n = static_cast<int>(pair.rows.size());
+    const double sqrt_weight = std::sqrt(pair.weight);
+    xa.resize(n);
+    xb.resize(n);
+    if (jacobians) {
+      ja.resize(n, columns);
+      jb.resize(n, columns);
+    }
+    for (int i = 0; i < n; ++i) {
+      const int k = pair.rows[i];
+      xa(i) = intensities[pair.a](k);
+      xb(i) = intensities[pair.b](k);
+      if (jacobians) {
+        ja.row(i) = view_jacobians[pair.a].row(k);
+        jb.row(i) = view_jacobians[pair.b].row(k);
+      }
+    }
+    NormalizeInPlace(xa, epsilon_, jacobians ? &ja : nullptr);
+    NormalizeInPlace(xb, epsilon_, jacobians ? &jb : nullptr);
+    Eigen::Map<Eigen::VectorXd>(residuals + offset, n) = sqrt_weight * (xa - xb);
+    if (jacobians) {
+      const int first_a = views_[pair.a].first_block, first_b = views_[pair.b].first_block;
+      for (int block = 0; block < blocks; ++block) {
+        if (!jacobians[block]) continue;
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
+            jacobians[block] + static_cast<std::ptrdiff_t>(offset) * dof_, n, dof_);
+        const int in_a = block - first_a, in_b = block - first_b;
+        if (in_a >= 0 && in_a * dof_ < columns) J += sqrt_weight * ja.middleCols(in_a * dof_, dof_);
+        if (in_b >= 0 && in_b * dof_ < columns) J -= sqrt_weight * jb.middleCols(in_b * dof_, dof_);
+      }
+    }
+    offset += n;
+  }
+  return true;
+}
+
+SignedDistanceImage ComputeSignedDistance(const cv::Mat& mask) {
+  if (mask.empty() || mask.type() != CV_8UC1)
+    ThrowError("ComputeSignedDistance", "mask", "must be a non-empty 8-bit single-channel image");
+  const cv::Mat inside = mask > 0;
+  const cv::Mat outside = mask == 0;
+  // distanceTransform gives each nonzero pixel its distance to the nearest zero pixel:
+  // outside pixels → distance to the object, inside pixels → distance to the background.
+  cv::Mat to_object, to_background;
+  cv::distanceTransform(outside, to_object, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(inside, to_background, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  SignedDistanceImage result;
+  // The outline lies half a pixel between an inside and an outside centre.
+  result.distance = cv::Mat(mask.size(), CV_32FC1);
+  for (int y = 0; y < mask.rows; ++y)
+    for (int x = 0; x < mask.cols; ++x)
+      result.distance.at<float>(y, x) = mask.at<std::uint8_t>(y, x) > 0
+                                            ? 0.5f - to_background.at<float>(y, x)
+                                            : to_object.at<float>(y, x) - 0.5f;
+  cv::Sobel(result.distance, result.gradient_x, CV_32F, 1, 0, 3, 1.0 / 8.0, 0, cv::BORDER_REPLICATE);
+  cv::Sobel(result.distance, result.gradient_y, CV_32F, 0, 1, 3, 1.0 / 8.0, 0, cv::BORDER_REPLICATE);
+  return result;
+}
+
+SilhouetteCost::SilhouetteCost(const SignedDistanceImage* distance, const vision::Camera* camera,
+                               Eigen::Vector3d base, Eigen::VectorXd stencil,
+                               std::vector<Eigen::Matrix3d> basis, int dof, double weight,
+                               bool one_sided)
+    : distance_(distance),
+      camera_(camera),
+      base_(std::move(base)),
+      stencil_(std::move(stencil)),
+      basis_(std::move(basis)),
+      dof_(dof),
+      weight_(weight),
+      one_sided_(one_sided) {
+  if (!distance_ || !camera_ || stencil_.size() != static_cast<Eigen::Index>(basis_.size()) ||
+      (dof != 1 && dof != 3))
+    ThrowError("SilhouetteCost", "arguments",
+               "needs a distance image, a camera, one basis per stencil weight and dof 1 or 3");
+  set_num_residuals(1);
+  for (std::size_t j = 0; j < basis_.size(); ++j) mutable_parameter_block_sizes()->push_back(dof);
+}
+
+bool SilhouetteCost::Evaluate(double const* const* parameters, double* residuals,
+                              double** jacobians) const {
+  const int support = static_cast<int>(basis_.size());
+  const Eigen::Vector3d X =
+      SamplePosition(base_, stencil_.data(), support, basis_, dof_, parameters, 0);
+  const Eigen::Vector2d pixel = camera_->ProjectUndistorted(X);
+  double value = 0.0, gx = 0.0, gy = 0.0;
+  const bool inside = SampleScalar(distance_->distance, pixel, &value) &&
+                      SampleScalar(distance_->gradient_x, pixel, &gx) &&
+                      SampleScalar(distance_->gradient_y, pixel, &gy);
+  if (!inside) {  // beyond the image border: no information, no force
+    value = 0.0;
+    gx = gy = 0.0;
+  }
+  const bool active = !one_sided_ || value > 0.0;
+  residuals[0] = active ? weight_ * value : 0.0;
+  if (!jacobians) return true;
+  const Eigen::RowVector3d g =
+      active ? Eigen::RowVector3d(weight_ * Eigen::RowVector2d(gx, gy) * camera_->ProjectionJacobian(X))
+             : Eigen::RowVector3d::Zero();
+  for (int j = 0; j < support; ++j) {
+    if (!jacobians[j]) continue;
+    for (int d = 0; d < dof_; ++d) jacobians[j][d] = stencil_(j) * g.dot(basis_[j].col(d));
+  }
+  return true;
+}
+
+}  // namespace subflow::solver

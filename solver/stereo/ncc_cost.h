@@ -1,0 +1,142 @@
+// The residuals of the spatio-temporal stereo functional (method §4.3, eq. 25) as Ceres
+// cost functions with analytic derivatives.
+//
+// Surface model inside one refinement step. A patch is a face r of the level ℓ being
+// refined; its samples k are limit-surface points whose position at frame t is
+//     X_k(t) = X⁰_k(t) + Σ_j w_kj B_j(t) e_j(t)
+// X⁰ the current surface (s = L c of the finest control points), j over the level-ℓ
+// vertices of the face's stencil support, w_kj the limit-stencil weights of level ℓ
+// (s = L_ℓ c_ℓ, eq. 12–13: the limit surface of the refined mesh is that of c_ℓ), B_j(t)
+// the 3×dof basis of vertex j's parameter block e_j(t): the vertex's Hoppe frame columns
+// (n, r, q) for detail increments, or the identity for base control points. The model is
+// exactly linear in e.
+//
+// NCC residual (PatchCorrelationCost). Two views a and b of the same samples — cameras
+// i ≠ j at one frame (stereo), or one camera at frames t ≠ s (the temporal
+// self-correlation of eq. 25) — give intensity vectors x_a, x_b (bilinear samples of the
+// smoothed images, one entry per sample). Each is normalized
+//     x̂ = (x − mean x) / σ,   σ = √(‖x − mean x‖² + m ε²)
+// (ε: the intensity noise floor, so a textureless patch gives a near-zero vector instead of
+// amplified noise; ε = 0 is the plain unit norm), and the residual is
+//     r = √W (x̂_a − x̂_b),   ‖r‖² = W (2 − 2 NCC)  when ε = 0,
+// so minimizing ½‖r‖² maximizes the weighted correlation exactly. Derivatives:
+//     ∂x_k/∂e_j = w_kj ∇I(p_k)ᵀ (∂p/∂X)(X_k) B_j         (eq. 4, 24: ProjectionJacobian)
+//     ∂x̂/∂x   = (I − 11ᵀ/m − x̂ x̂ᵀ) / σ.
+// A sample whose projection leaves the image is clamped to the border (its gradient
+// there is zero), so the residual stays defined while the optimizer explores.
+//
+// Silhouette residual (SilhouetteCost): one sample, one camera, one frame,
+//     r = w · D(p(X))        (one-sided: max(0, D) when `one_sided`)
+// D the signed distance to the outline of the silhouette (pixels, > 0 outside; bilinear),
+// so the surface's outline is pulled onto the mask and no point is pushed outside it.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <ceres/cost_function.h>
+
+#include "solver/observation/image_derivatives.h"
+#include "vision/camera.h"
+
+namespace subflow::solver {
+
+// The samples of one patch in one view: image, camera, and per sample its current
+// position X⁰ (rows), all at one frame. `first_block` is the index, among the cost's
+// parameter blocks, of the frame's block for support vertex 0; support vertex j uses
+// first_block + j.
+struct PatchView {
+  const SmoothedImage* image = nullptr;
+  const vision::Camera* camera = nullptr;
+  std::vector<Eigen::Vector3d> base;  // X⁰ per sample (size m)
+  // B_j per support vertex (3×dof each, column-major dof columns).
+  std::vector<Eigen::Matrix3d> basis;
+  int first_block = 0;
+};
+
+// Limit-stencil weights of the samples on the patch's support vertices (m × #support,
+// dense: supports are small, 12 for a regular patch).
+using PatchStencil = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// Jacobians of intensity vectors: one row per sample (row-major, rows are gathered).
+using RowJacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// Intensities (m) of a view at the current parameters, and ∂x/∂e (m × blocks·dof) when
+// `jacobian` is given. `parameters` are the cost's parameter blocks. When `rows` is given
+// only those samples are evaluated (the others are left at zero).
+void SampleView(const PatchView& view, const PatchStencil& stencil, int dof,
+                double const* const* parameters, Eigen::VectorXd* intensities,
+                RowJacobian* jacobian, const std::vector<int>* rows = nullptr);
+
+// x̂ = (x − mean)/σ (see the file comment); when `d_normalized` is given, it is replaced
+// by ∂x̂/∂θ for ∂x/∂θ = *d_normalized on input (any column count).
+Eigen::VectorXd NormalizeIntensities(const Eigen::VectorXd& x, double epsilon,
+                                     RowJacobian* d_normalized = nullptr);
+
+// One correlation of a patch: views a and b compared on the samples both see.
+struct CorrelationPair {
+  int a = 0, b = 0;
+  std::vector<int> rows;  // sample indices (rows of the stencil), at least 2
+  double weight = 1.0;    // W
+};
+
+// All correlations of one patch in one residual block: the stereo pairs of a frame (the
+// views share the frame's blocks), or the temporal self-correlations of a frame step (the
+// views of frame t use blocks [0, #support), those of t + 1 the next #support). Each view
+// is sampled once however many pairs use it; the residual is the concatenation of the
+// pairs' √W (x̂_a − x̂_b), each normalized on its own rows, so ‖r‖² = Σ W (2 − 2 NCC).
+class PatchCorrelationCost final : public ceres::CostFunction {
+ public:
+  // `block_count` parameter blocks of size `dof` (1 or 3). Throws subflow::Error on
+  // inconsistent sizes, indices or weights.
+  PatchCorrelationCost(PatchStencil stencil, std::vector<PatchView> views,
+                       std::vector<CorrelationPair> pairs, int block_count, int dof, double epsilon);
+  // A single pair (a, b) on all samples, weight W.
+  PatchCorrelationCost(PatchStencil stencil, PatchView a, PatchView b, int block_count, int dof,
+                       double weight, double epsilon);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+  const std::vector<CorrelationPair>& pairs() const { return pairs_; }
+
+ private:
+  PatchStencil stencil_;
+  std::vector<PatchView> views_;
+  std::vector<CorrelationPair> pairs_;
+  std::vector<std::vector<int>> view_rows_;  // the rows each view must sample
+  int dof_;
+  double epsilon_;
+};
+
+// Signed distance to a silhouette's outline, and its gradient, for SilhouetteCost.
+struct SignedDistanceImage {
+  cv::Mat distance;    // CV_32FC1, pixels, > 0 outside the silhouette, < 0 inside
+  cv::Mat gradient_x;  // CV_32FC1
+  cv::Mat gradient_y;  // CV_32FC1
+};
+// From a CV_8UC1 mask (nonzero = object). Throws subflow::Error on an empty or
+// non-8-bit mask.
+SignedDistanceImage ComputeSignedDistance(const cv::Mat& mask);
+
+class SilhouetteCost final : public ceres::CostFunction {
+ public:
+  // One sample: X⁰, stencil weights on `basis.size()` support blocks of size dof.
+  SilhouetteCost(const SignedDistanceImage* distance, const vision::Camera* camera,
+                 Eigen::Vector3d base, Eigen::VectorXd stencil, std::vector<Eigen::Matrix3d> basis,
+                 int dof, double weight, bool one_sided);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const SignedDistanceImage* distance_;
+  const vision::Camera* camera_;
+  Eigen::Vector3d base_;
+  Eigen::VectorXd stencil_;
+  std::vector<Eigen::Matrix3d> basis_;
+  int dof_;
+  double weight_;
+  bool one_sided_;
+};
+
+}  // namespace subflow::solver

@@ -1,0 +1,172 @@
+#include "solver/stereo/photometric_residuals.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <utility>
+
+#include "solver/stereo/stereo_refinement.h"
+
+namespace subflow::solver {
+namespace {
+
+// The parameter blocks of the support vertices of a patch at a frame, appended.
+void AppendBlocks(RefinementWindow& window, int frame, const std::vector<int>& support,
+                  std::vector<double*>* blocks) {
+  for (int v : support) blocks->push_back(window.Increment(frame, v));
+}
+
+std::vector<Eigen::Matrix3d> BasesOf(const RefinementWindow& window, int frame, const std::vector<int>& support) {
+  std::vector<Eigen::Matrix3d> basis;
+  basis.reserve(support.size());
+  for (int v : support) basis.push_back(window.states.at(frame).basis[v]);
+  return basis;
+}
+
+// The rows (samples of `face`) usable in every given (frame, camera) view.
+std::vector<int> CommonRows(const RefinementWindow& window, int face,
+                            const std::vector<std::pair<int, int>>& views) {
+  const int first = window.sampling->face_first[face], m = window.sampling->FaceSampleCount(face);
+  std::vector<int> rows;
+  for (int s = 0; s < m; ++s) {
+    bool all = true;
+    for (const auto& [frame, k] : views) all = all && window.states.at(frame).usable[k][first + s];
+    if (all) rows.push_back(s);
+  }
+  return rows;
+}
+
+PatchView MakeView(RefinementWindow& window, int frame, int camera, int face, int first_block) {
+  const int first = window.sampling->face_first[face], m = window.sampling->FaceSampleCount(face);
+  PatchView view;
+  view.image = &window.images->Gray(frame)[camera];
+  view.camera = &(*window.cameras)[camera];
+  for (int s = 0; s < m; ++s) view.base.push_back(window.states.at(frame).positions.row(first + s).transpose());
+  view.basis = BasesOf(window, frame, window.sampling->support[face]);
+  view.first_block = first_block;
+  return view;
+}
+
+}  // namespace
+
+PatchCameras CamerasOfPatch(const RefinementWindow& window, int frame, int face) {
+  const StereoRefinementOptions& options = *window.options;
+  const std::vector<vision::Camera>& cameras = *window.cameras;
+  const FrameState& state = window.states.at(frame);
+  const int first = window.sampling->face_first[face], m = window.sampling->FaceSampleCount(face);
+  std::vector<std::pair<double, int>> ranked;
+  for (int k = 0; k < static_cast<int>(cameras.size()); ++k) {
+    const std::vector<std::uint8_t>& visible = state.usable[k];
+    int count = 0;
+    double cosine = 0.0;
+    const Eigen::Vector3d center = cameras[k].Center();
+    for (int s = first; s < first + m; ++s) {
+      if (!visible[s]) continue;
+      ++count;
+      const Eigen::Vector3d X = state.positions.row(s).transpose();
+      cosine += state.normals.row(s).dot((center - X).normalized());
+    }
+    if (count >= std::max(options.min_samples, (m + 1) / 2)) ranked.emplace_back(cosine / count, k);
+  }
+  std::sort(ranked.begin(), ranked.end(), std::greater<>());
+  PatchCameras result;
+  for (std::size_t i = 0; i < ranked.size() && static_cast<int>(i) < options.max_cameras; ++i) {
+    result.cosines.push_back(ranked[i].first);
+    result.cameras.push_back(ranked[i].second);
+  }
+  return result;
+}
+
+std::optional<ResidualRecord> AddStereoResidual(RefinementWindow& window, int frame, int face,
+                                                const PatchCameras& seen, ceres::LossFunction* loss,
+                                                ceres::Problem* problem) {
+  const StereoRefinementOptions& options = *window.options;
+  const std::vector<int>& support = window.sampling->support[face];
+  const int n_seen = static_cast<int>(seen.cameras.size());
+  // Each camera's samples are evaluated once, however many pairs use them.
+  std::vector<PatchView> views;
+  for (int a = 0; a < n_seen; ++a) views.push_back(MakeView(window, frame, seen.cameras[a], face, 0));
+  std::vector<CorrelationPair> pairs;
+  for (int a = 0; a < n_seen; ++a)
+    for (int b = a + 1; b < n_seen; ++b) {
+      std::vector<int> rows = CommonRows(window, face, {{frame, seen.cameras[a]}, {frame, seen.cameras[b]}});
+      if (static_cast<int>(rows.size()) < options.min_samples) continue;
+      const double weight = std::pow(std::max(0.0, seen.cosines[a]) * std::max(0.0, seen.cosines[b]),
+                                     options.angle_weight_power);
+      pairs.push_back({a, b, std::move(rows), weight});
+    }
+  if (pairs.empty()) return std::nullopt;
+  std::vector<double*> blocks;
+  AppendBlocks(window, frame, support, &blocks);
+  auto* cost = new PatchCorrelationCost(window.sampling->stencil[face], std::move(views), std::move(pairs),
+                                        static_cast<int>(support.size()), window.dof, options.ncc_epsilon);
+  return ResidualRecord{problem->AddResidualBlock(cost, loss, blocks), frame, cost};
+}
+
+int AddTemporalResiduals(RefinementWindow& window, int frame, int face, const PatchCameras& seen,
+                         ceres::LossFunction* loss, ceres::Problem* problem) {
+  const StereoRefinementOptions& options = *window.options;
+  if (options.temporal_weight <= 0) return 0;
+  const std::vector<int>& support = window.sampling->support[face];
+  const int support_size = static_cast<int>(support.size());
+  std::vector<std::pair<int, int>> steps;
+  if (frame + 1 < window.frame_count) steps.emplace_back(frame, frame + 1);
+  if (frame == window.first && frame > 0) steps.emplace_back(frame - 1, frame);
+  int added = 0;
+  for (const auto& [ta, tb] : steps) {
+    std::vector<PatchView> views;
+    std::vector<CorrelationPair> pairs;
+    for (std::size_t a = 0; a < seen.cameras.size(); ++a) {
+      const int i = seen.cameras[a];
+      std::vector<int> rows = CommonRows(window, face, {{ta, i}, {tb, i}});
+      if (static_cast<int>(rows.size()) < options.min_samples) continue;
+      const double weight = options.temporal_weight *
+                            std::pow(std::max(0.0, seen.cosines[a]), 2.0 * options.angle_weight_power);
+      const int index = static_cast<int>(views.size());
+      views.push_back(MakeView(window, ta, i, face, 0));
+      views.push_back(MakeView(window, tb, i, face, support_size));
+      pairs.push_back({index, index + 1, std::move(rows), weight});
+    }
+    if (pairs.empty()) continue;
+    std::vector<double*> blocks;
+    AppendBlocks(window, ta, support, &blocks);
+    AppendBlocks(window, tb, support, &blocks);
+    problem->AddResidualBlock(new PatchCorrelationCost(window.sampling->stencil[face], std::move(views),
+                                                       std::move(pairs), 2 * support_size, window.dof,
+                                                       options.ncc_epsilon),
+                              loss, blocks);
+    ++added;
+  }
+  return added;
+}
+
+void AddSilhouetteResiduals(RefinementWindow& window, int frame, int face, ceres::Problem* problem,
+                            std::vector<ResidualRecord>* records) {
+  const StereoRefinementOptions& options = *window.options;
+  if (options.silhouette_weight <= 0) return;
+  const std::vector<vision::Camera>& cameras = *window.cameras;
+  const auto& distances = window.images->Silhouettes(frame);
+  const std::vector<int>& support = window.sampling->support[face];
+  const PatchStencil& stencil = window.sampling->stencil[face];
+  const int m = window.sampling->FaceSampleCount(face);
+  const int s = window.sampling->face_first[face] + m / 2;
+  const Eigen::Vector3d X = window.states.at(frame).positions.row(s).transpose();
+  for (int k = 0; k < static_cast<int>(cameras.size()); ++k) {
+    if (!distances[k]) continue;
+    double depth = 0.0;
+    const Eigen::Vector2d p = cameras[k].ProjectUndistorted(X, &depth);
+    double distance = 0.0;
+    if (depth <= 0 || !SampleScalar(distances[k]->distance, p, &distance)) continue;
+    // Inside by more than half a pixel: the one-sided term is inactive. About a quarter of
+    // a convex surface projects within 2 px of its outline in a camera, so a wider band
+    // would cost many blocks for nothing.
+    if (distance < -0.5) continue;
+    std::vector<double*> blocks;
+    AppendBlocks(window, frame, support, &blocks);
+    auto* cost = new SilhouetteCost(distances[k].get(), &cameras[k], X, stencil.row(m / 2).transpose(),
+                                    BasesOf(window, frame, support), window.dof, options.silhouette_weight, true);
+    records->push_back({problem->AddResidualBlock(cost, nullptr, blocks), frame, nullptr});
+  }
+}
+
+}  // namespace subflow::solver

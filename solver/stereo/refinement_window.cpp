@@ -1,0 +1,144 @@
+#include "solver/stereo/refinement_window.h"
+
+#include <Eigen/Geometry>
+#include <tbb/parallel_for.h>
+
+#include "geometry/local_frames.h"
+#include "geometry/mean_edge_length.h"
+#include "solver/stereo/stereo_refinement.h"
+
+namespace subflow::solver {
+
+using geometry::LoopHierarchy;
+using geometry::Positions;
+
+
+FrameImageCache::FrameImageCache(const vision::ImageSequence& images, double sigma)
+    : images_(images), sigma_(sigma) {}
+
+const std::vector<SmoothedImage>& FrameImageCache::Gray(int frame) {
+  auto it = gray_cache_.find(frame);
+  if (it != gray_cache_.end()) return it->second;
+  const int cameras = images_.camera_count();
+  std::vector<SmoothedImage> smoothed(cameras);
+  tbb::parallel_for(0, cameras, [&](int k) { smoothed[k] = SmoothImage(GrayFloat(images_.gray(k, frame)), sigma_); });
+  return gray_cache_.emplace(frame, std::move(smoothed)).first->second;
+}
+
+const std::vector<std::unique_ptr<SignedDistanceImage>>& FrameImageCache::Silhouettes(int frame) {
+  auto it = silhouette_cache_.find(frame);
+  if (it != silhouette_cache_.end()) return it->second;
+  const int cameras = images_.camera_count();
+  std::vector<std::unique_ptr<SignedDistanceImage>> distances(cameras);
+  if (images_.silhouette) {
+    tbb::parallel_for(0, cameras, [&](int k) {
+      const cv::Mat mask = images_.silhouette(k, frame);
+      if (!mask.empty()) distances[k] = std::make_unique<SignedDistanceImage>(ComputeSignedDistance(mask));
+    });
+  }
+  return silhouette_cache_.emplace(frame, std::move(distances)).first->second;
+}
+
+void FrameImageCache::Release(int first_kept) {
+  for (auto it = gray_cache_.begin(); it != gray_cache_.end();) it = it->first < first_kept ? gray_cache_.erase(it) : ++it;
+  for (auto it = silhouette_cache_.begin(); it != silhouette_cache_.end();)
+    it = it->first < first_kept ? silhouette_cache_.erase(it) : ++it;
+}
+
+RefinementLevel PrepareLevel(const LoopHierarchy& hierarchy, const std::vector<vision::Camera>& cameras,
+                             const StereoRefinementOptions& options, const geometry::Trajectory& trajectory,
+                             int level, std::vector<char> active_faces) {
+  RefinementLevel prepared;
+  prepared.level = level;
+  prepared.dof = level >= options.normal_only_from_level ? 1 : 3;
+  const int reference = static_cast<int>(trajectory.size()) / 2;
+  const Positions reference_level = trajectory[reference].Synthesize(hierarchy, level);
+  prepared.h = geometry::MeanEdgeLength(hierarchy.Topology(level), reference_level);
+  prepared.sampling = SampleLevel(hierarchy, level, reference_level, cameras, options);
+  prepared.visibility = std::make_unique<VisibilityTester>(hierarchy, hierarchy.finest_level(), options.visibility);
+  prepared.active_faces = std::move(active_faces);
+  return prepared;
+}
+
+RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& hierarchy,
+                            const std::vector<vision::Camera>& cameras, const StereoRefinementOptions& options,
+                            const geometry::Trajectory& trajectory, const std::vector<Positions>& control,
+                            FrameImageCache* images, int first, int last) {
+  RefinementWindow window;
+  window.options = &options;
+  window.cameras = &cameras;
+  window.hierarchy = &hierarchy;
+  window.trajectory = &trajectory;
+  window.sampling = &level.sampling;
+  window.images = images;
+  window.level = level.level;
+  window.dof = level.dof;
+  window.first = first;
+  window.last = last;
+  window.frame_count = static_cast<int>(control.size());
+  window.h = level.h;
+  window.active_faces = level.active_faces;
+  const geometry::Faces& F = hierarchy.LevelFaces(level.level);
+  window.active_vertices.assign(hierarchy.VertexCount(level.level), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (window.active_faces[f])
+      for (int k = 0; k < 3; ++k) window.active_vertices[F(f, k)] = 1;
+  const int c0 = std::max(0, first - 1), c1 = std::min(window.frame_count - 1, last + 1);
+  for (int f = c0; f <= c1; ++f)
+    window.states.emplace(f, MakeFrameState(hierarchy, level.level, level.dof, trajectory[f], control[f],
+                                            level.sampling, *level.visibility, cameras, images->Silhouettes(f),
+                                            options.outline_margin));
+  return window;
+}
+
+FrameState MakeFrameState(const LoopHierarchy& hierarchy, int level, int dof,
+                          const geometry::MultiresShape& shape, const Positions& finest_control,
+                          const LevelSampling& sampling, const VisibilityTester& tester,
+                          const std::vector<vision::Camera>& cameras,
+                          const std::vector<std::unique_ptr<SignedDistanceImage>>& silhouettes,
+                          double outline_margin) {
+  FrameState state;
+  std::vector<geometry::LocalFrames> frames;
+  state.level_control = shape.Synthesize(hierarchy, level, &frames);
+  const int vertices = hierarchy.VertexCount(level);
+  state.basis.resize(vertices);
+  if (level == 0) {
+    const Positions normals = geometry::LimitNormals(hierarchy, 0, state.level_control);
+    for (int v = 0; v < vertices; ++v) {
+      if (dof == 3) {
+        state.basis[v].setIdentity();
+      } else {
+        state.basis[v].setZero();
+        state.basis[v].col(0) = normals.row(v).transpose();
+      }
+    }
+  } else {
+    const geometry::LocalFrames& F = frames.at(level - 1);
+    for (int v = 0; v < vertices; ++v) {
+      state.basis[v].col(0) = F.normal.row(v).transpose();
+      state.basis[v].col(1) = F.r.row(v).transpose();
+      state.basis[v].col(2) = F.q.row(v).transpose();
+    }
+  }
+  state.positions = sampling.finest_limit * finest_control;
+  const Positions du = sampling.finest_du * finest_control;
+  const Positions dv = sampling.finest_dv * finest_control;
+  state.normals.resize(state.positions.rows(), 3);
+  for (Eigen::Index s = 0; s < du.rows(); ++s)
+    state.normals.row(s) = du.row(s).cross(dv.row(s)).normalized();
+  state.usable = tester.Compute(cameras, finest_control, state.positions, state.normals).visible;
+  tbb::parallel_for(0, static_cast<int>(cameras.size()), [&](int k) {
+    if (!silhouettes[k]) return;
+    for (Eigen::Index s = 0; s < state.positions.rows(); ++s) {
+      if (!state.usable[k][s]) continue;
+      double distance = 0.0;
+      const Eigen::Vector2d p = cameras[k].ProjectUndistorted(state.positions.row(s).transpose());
+      if (!SampleScalar(silhouettes[k]->distance, p, &distance) || distance > -outline_margin)
+        state.usable[k][s] = 0;
+    }
+  });
+  state.increments.assign(static_cast<std::size_t>(vertices) * dof, 0.0);
+  return state;
+}
+
+}  // namespace subflow::solver

@@ -1,0 +1,127 @@
+// One temporal window of one level of the stereo refinement (stereo_refinement.h): what
+// its residuals are built from (photometric_residuals.h, regularization_residuals.h) and
+// what window_solve.h solves. Frames [first, last] are solved; frames first − 1 and
+// last + 1, where they exist, enter with their current values as constants.
+//
+// Per frame t of the window and its context frames (FrameState):
+//   c(ℓ)       the level-ℓ control points of the current shape (#V(ℓ)×3)
+//   B_v        per level-ℓ vertex v, the 3×3 basis of its increment e_v: the Hoppe frame
+//              (n, r, q) of C c(ℓ−1) at v for details (ℓ > 0), the identity for base
+//              control points (ℓ = 0, dof 3) or the limit normal in column 0 (dof 1); the
+//              first `dof` columns are used
+//   X, n       per sample (LevelSampling), the position and unit normal of the current
+//              finest limit surface
+//   usable     per camera and sample: visible (VisibilityTester) and, where the camera has
+//              a silhouette, at least outline_margin pixels inside it
+//   e          the unknowns, #V(ℓ) × dof, zero at the start: parameter block of vertex v
+//              at frame t = Increment(t, v)
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "geometry/loop_hierarchy.h"
+#include "geometry/multires_shape.h"
+#include "solver/observation/image_derivatives.h"
+#include "solver/observation/sample_visibility.h"
+#include "solver/stereo/level_sampling.h"
+#include "solver/stereo/ncc_cost.h"
+#include "vision/image_sequence.h"
+
+namespace subflow::solver {
+
+struct StereoRefinementOptions;
+
+// The images of the frames a window needs, smoothed (σ = image_sigma) and the silhouettes'
+// signed distances, each computed once and released when no later window needs them.
+class FrameImageCache {
+ public:
+  FrameImageCache(const vision::ImageSequence& images, double sigma);
+
+  // Per camera: the smoothed gray image of `frame`.
+  const std::vector<SmoothedImage>& Gray(int frame);
+  // Per camera: the signed distance to the silhouette's outline at `frame`, or null.
+  const std::vector<std::unique_ptr<SignedDistanceImage>>& Silhouettes(int frame);
+  // Forgets the frames before `first_kept`.
+  void Release(int first_kept);
+
+ private:
+  const vision::ImageSequence& images_;
+  double sigma_;
+  std::map<int, std::vector<SmoothedImage>> gray_cache_;
+  std::map<int, std::vector<std::unique_ptr<SignedDistanceImage>>> silhouette_cache_;
+};
+
+struct FrameState {
+  geometry::Positions level_control;   // c(ℓ), #V(ℓ)×3
+  std::vector<Eigen::Matrix3d> basis;  // per level-ℓ vertex: B_v (see the file comment)
+  geometry::Positions positions, normals;  // per sample (finest limit surface), #S×3
+  // usable[k][s]: visible in camera k and, where camera k has a silhouette, at least
+  // `outline_margin` pixels inside it: the smoothed intensity of a sample near the outline
+  // mixes in the background, which biases the correlation towards shrinking the surface.
+  std::vector<std::vector<std::uint8_t>> usable;
+  std::vector<double> increments;  // e: #V(ℓ) × dof, zero at the start
+};
+
+struct RefinementWindow {
+  const StereoRefinementOptions* options = nullptr;
+  const std::vector<vision::Camera>* cameras = nullptr;
+  const geometry::LoopHierarchy* hierarchy = nullptr;
+  const geometry::Trajectory* trajectory = nullptr;  // the current shapes of all frames
+  const LevelSampling* sampling = nullptr;
+  FrameImageCache* images = nullptr;
+  int level = 0;
+  int dof = 1;            // unknowns per vertex: 3, or 1 (normal only)
+  int first = 0, last = 0;  // the frames solved
+  int frame_count = 0;    // frames of the sequence
+  double h = 0.0;         // mean edge length of the level: the unit of steps and weights
+  std::vector<char> active_faces;     // #F(ℓ): refined at this level (adaptivity)
+  std::vector<char> active_vertices;  // #V(ℓ): corners of active faces
+  std::map<int, FrameState> states;   // frames max(0, first − 1) … min(frame_count − 1, last + 1)
+
+  double* Increment(int frame, int vertex) {
+    return states.at(frame).increments.data() + static_cast<std::ptrdiff_t>(vertex) * dof;
+  }
+  // B_v at `frame`, its first dof columns (3×dof).
+  Eigen::MatrixXd Basis(int frame, int vertex) const {
+    return states.at(frame).basis[vertex].leftCols(dof);
+  }
+};
+
+// What every window of one level shares.
+struct RefinementLevel {
+  int level = 0;
+  int dof = 1;
+  double h = 0.0;  // mean edge length of level ℓ at the reference (middle) frame
+  LevelSampling sampling;
+  std::unique_ptr<VisibilityTester> visibility;  // of the finest level's limit surface
+  std::vector<char> active_faces;                // #F(ℓ)
+};
+
+// Level ℓ of the refinement of `trajectory` (its middle frame is the reference): dof by
+// normal_only_from_level, samples and h at the reference frame.
+RefinementLevel PrepareLevel(const geometry::LoopHierarchy& hierarchy, const std::vector<vision::Camera>& cameras,
+                             const StereoRefinementOptions& options, const geometry::Trajectory& trajectory,
+                             int level, std::vector<char> active_faces);
+
+// The window [first, last] of `level`: the states of its frames and context frames from the
+// current shapes (`trajectory`, finest control points `control`, all frames).
+RefinementWindow OpenWindow(const RefinementLevel& level, const geometry::LoopHierarchy& hierarchy,
+                            const std::vector<vision::Camera>& cameras, const StereoRefinementOptions& options,
+                            const geometry::Trajectory& trajectory, const std::vector<geometry::Positions>& control,
+                            FrameImageCache* images, int first, int last);
+
+// The state of one frame at level ℓ: `shape` and `finest_control` are the frame's current
+// multires shape and finest control points; `silhouettes` its signed distances per camera.
+FrameState MakeFrameState(const geometry::LoopHierarchy& hierarchy, int level, int dof,
+                          const geometry::MultiresShape& shape, const geometry::Positions& finest_control,
+                          const LevelSampling& sampling, const VisibilityTester& tester,
+                          const std::vector<vision::Camera>& cameras,
+                          const std::vector<std::unique_ptr<SignedDistanceImage>>& silhouettes,
+                          double outline_margin);
+
+}  // namespace subflow::solver

@@ -1,0 +1,291 @@
+#include "solver/stereo/stereo_refinement.h"
+
+#include <algorithm>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include <Eigen/Geometry>
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
+#include "core/error.h"
+#include "core/stopwatch.h"
+#include "geometry/multires_shape.h"
+#include "solver/stereo/refinement_window.h"
+#include "solver/stereo/window_solve.h"
+
+namespace subflow::solver {
+namespace {
+
+using geometry::LoopHierarchy;
+using geometry::Positions;
+
+// The frame ranges [w0, w1] of the windows over `frames` frames: `window` frames each
+// (fewer at the end), consecutive ones sharing min(overlap, window − 1) frames.
+std::vector<std::pair<int, int>> Windows(int frames, int window, int overlap) {
+  std::vector<std::pair<int, int>> windows;
+  const int step = window - std::min(overlap, window - 1);
+  for (int w0 = 0;; w0 += step) {
+    const int w1 = std::min(frames - 1, w0 + window - 1);
+    windows.emplace_back(w0, w1);
+    if (w1 == frames - 1) break;
+  }
+  return windows;
+}
+
+// The finest level whose faces' median largest projected area (over the cameras facing
+// them) is at least `min_area` pixels²; level 0 when none is. Areas shrink 4× per level.
+int AutomaticFinestLevel(const LoopHierarchy& hierarchy, const Positions& finest_control,
+                         const std::vector<vision::Camera>& cameras, double min_area) {
+  const Positions base = geometry::MultiresShape::Analyze(hierarchy, finest_control).base();
+  const Positions corners = hierarchy.LimitPositions(0) * base;
+  const geometry::Faces& F = hierarchy.LevelFaces(0);
+  std::vector<double> areas;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d X0 = corners.row(F(f, 0)), X1 = corners.row(F(f, 1)), X2 = corners.row(F(f, 2));
+    const Eigen::Vector3d normal = (X1 - X0).cross(X2 - X0);
+    double largest = 0.0;
+    for (const vision::Camera& camera : cameras) {
+      if (normal.dot(camera.Center() - (X0 + X1 + X2) / 3.0) <= 0.0) continue;
+      const Eigen::Vector2d a = camera.ProjectUndistorted(X1) - camera.ProjectUndistorted(X0);
+      const Eigen::Vector2d b = camera.ProjectUndistorted(X2) - camera.ProjectUndistorted(X0);
+      largest = std::max(largest, 0.5 * std::abs(a.x() * b.y() - a.y() * b.x()));
+    }
+    if (largest > 0.0) areas.push_back(largest);
+  }
+  if (areas.empty()) return 0;
+  std::nth_element(areas.begin(), areas.begin() + areas.size() / 2, areas.end());
+  double area = areas[areas.size() / 2];
+  int level = 0;
+  while (level < hierarchy.finest_level() && area / 4.0 >= min_area) {
+    area /= 4.0;
+    ++level;
+  }
+  return level;
+}
+
+
+// The refinement state of the whole sequence, which the windows' solutions move.
+struct SequenceState {
+  geometry::Trajectory trajectory;
+  RefinementResult* result;  // control (finest control points) and the per-frame figures
+};
+
+// Adds a window's solution to the shapes of its frames (base control points at level 0,
+// details in their local frames above), re-synthesizes their finest control points and
+// records the figures; `moved` keeps the largest world displacement of every vertex.
+void ApplySolution(const LoopHierarchy& hierarchy, int level, const WindowSolution& solution,
+                   SequenceState* state, std::vector<double>* moved) {
+  const int finest = hierarchy.finest_level();
+  for (int t = solution.first; t <= solution.last; ++t) {
+    const int i = t - solution.first;
+    const WindowSolution::Increments& e = solution.increments[i];
+    const Positions& world = solution.displacement[i];
+    geometry::MultiresShape& shape = state->trajectory[t];
+    Positions& target = level == 0 ? shape.base() : shape.Detail(level);
+    for (Eigen::Index v = 0; v < world.rows(); ++v) {
+      const Eigen::Vector3d displacement = world.row(v).transpose();
+      (*moved)[v] = std::max((*moved)[v], displacement.norm());
+      if (level == 0) {
+        target.row(v) += displacement.transpose();
+      } else {
+        for (Eigen::Index d = 0; d < e.cols(); ++d) target(v, d) += e(v, d);  // local (n, r, q)
+      }
+    }
+    state->result->control[t] = shape.Synthesize(hierarchy, finest);
+
+    const WindowFrameFigures& figures = solution.frames[i];
+    RefinementFrameReport& report = state->result->frames[t];
+    if (report.stereo_pairs == 0 && figures.stereo_pairs > 0) {  // first time this frame is refined
+      report.ncc_before = figures.ncc_before;
+      report.silhouette_rms_before = figures.silhouette_rms_before;
+    }
+    if (figures.stereo_pairs > 0) {
+      report.stereo_pairs = figures.stereo_pairs;
+      report.ncc_after = figures.ncc_after;
+      report.silhouette_rms_after = figures.silhouette_rms_after;
+    }
+  }
+}
+
+// Refines level ℓ over all frames, window by window, `rounds` times; returns the vertices
+// of ℓ that moved by more than the adaptive threshold (the next level's active patches).
+std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHierarchy& hierarchy,
+                              const vision::Bounds& bounds, const StereoRefinementOptions& options,
+                              int level, std::vector<char> active_faces, FrameImageCache* cache,
+                              SequenceState* state, Progress* progress, std::size_t* progress_done) {
+  const Stopwatch start;
+  const RefinementLevel prepared =
+      PrepareLevel(hierarchy, images.cameras, options, state->trajectory, level, std::move(active_faces));
+  RefinementLevelReport report;
+  report.level = level;
+  report.dof = prepared.dof;
+  report.patches = hierarchy.FaceCount(level);
+  report.active_patches = static_cast<int>(std::count(prepared.active_faces.begin(), prepared.active_faces.end(), 1));
+  report.active_fraction = static_cast<double>(report.active_patches) / report.patches;
+  std::vector<double> moved(hierarchy.VertexCount(level), 0.0);
+  const int frames = static_cast<int>(state->result->control.size());
+  const auto windows = Windows(frames, options.window, options.window_overlap);
+  report.windows = static_cast<int>(windows.size());
+  for (int round = 0; round < options.rounds; ++round) {
+    report.parameters = 0;
+    report.residual_blocks = 0;
+    for (std::size_t w = 0; w < windows.size(); ++w) {
+      RefinementWindow window = OpenWindow(prepared, hierarchy, images.cameras, options, state->trajectory,
+                                           state->result->control, cache, windows[w].first, windows[w].second);
+      const WindowSolution solution = SolveWindow(window, bounds);
+      report.parameters += solution.parameters;
+      report.residual_blocks += solution.residual_blocks;
+      report.iterations += solution.iterations;
+      report.solver_seconds += solution.solver_seconds;
+      ApplySolution(hierarchy, level, solution, state, &moved);
+      // The next window needs its frames and its context frame before them.
+      if (w + 1 < windows.size()) cache->Release(windows[w + 1].first - 1);
+      ProgressUpdate(progress, ++*progress_done);
+    }
+  }
+  double moved_sum = 0.0;
+  std::vector<char> moved_vertices(moved.size(), 0);
+  for (std::size_t v = 0; v < moved.size(); ++v) {
+    moved_sum += moved[v];
+    moved_vertices[v] = moved[v] > options.adaptive_threshold * prepared.h ? 1 : 0;
+  }
+  report.mean_increment = moved_sum / static_cast<double>(moved.size());
+  report.seconds = start.Seconds();
+  spdlog::info("refinement level {}: {} of {} patches, dof {}, {} unknowns, {} residual blocks, "
+               "{} iterations, mean max |increment| {:.3g}, {:.1f} s ({:.1f} s in Ceres)",
+               level, report.active_patches, report.patches, report.dof, report.parameters,
+               report.residual_blocks, report.iterations, report.mean_increment, report.seconds,
+               report.solver_seconds);
+  state->result->levels.push_back(report);
+  return moved_vertices;
+}
+
+}  // namespace
+
+std::string RefinementResult::BriefReport() const {
+  std::string level_list;
+  int iterations = 0;
+  double solver_seconds = 0;
+  for (const RefinementLevelReport& level : levels) {
+    level_list += fmt::format("{}{} ({:.0f} %)", level_list.empty() ? "" : ", ", level.level, 100 * level.active_fraction);
+    iterations += level.iterations;
+    solver_seconds += level.solver_seconds;
+  }
+  double before = 0, after = 0;
+  int refined = 0;
+  for (const RefinementFrameReport& frame : frames)
+    if (frame.stereo_pairs > 0) before += frame.ncc_before, after += frame.ncc_after, ++refined;
+  return fmt::format("refinement: levels {}, {} Ceres iterations, mean NCC {:.4f} → {:.4f} over {} frames, "
+                     "{:.1f} s ({:.1f} s in Ceres)",
+                     level_list, iterations, refined ? before / refined : 0.0, refined ? after / refined : 0.0,
+                     refined, seconds, solver_seconds);
+}
+
+void WindowSolverOptions::Check() const {
+  if (max_iterations < 1) ThrowError("stereo refinement options", "solver.max_iterations", "must be ≥ 1");
+  if (threads < 0) ThrowError("stereo refinement options", "solver.threads", "must be ≥ 0 (0 = all cores)");
+  if (!(function_tolerance > 0)) ThrowError("stereo refinement options", "solver.function_tolerance", "must be > 0");
+  std::string why;
+  if (!ToCeres().IsValid(&why)) ThrowError("stereo refinement options", "solver", why);
+}
+
+ceres::Solver::Options WindowSolverOptions::ToCeres() const {
+  ceres::Solver::Options options;
+  options.linear_solver_type = linear_solver;
+  options.max_num_iterations = max_iterations;
+  options.num_threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.minimizer_progress_to_stdout = false;
+  options.logging_type = ceres::SILENT;
+  options.function_tolerance = function_tolerance;
+  return options;
+}
+
+void StereoRefinementOptions::Check() const {
+  auto require = [](bool ok, const char* field, const char* expected) {
+    if (!ok) ThrowError("stereo refinement options", field, expected);
+  };
+  require(coarsest_level >= 0, "coarsest_level", "must be ≥ 0");
+  require(normal_only_from_level >= 0, "normal_only_from_level", "must be ≥ 0");
+  require(window >= 1, "window", "must be ≥ 1");
+  require(window_overlap >= 0, "window_overlap", "must be ≥ 0");
+  require(rounds >= 1, "rounds", "must be ≥ 1");
+  require(samples_per_pixel > 0, "samples_per_pixel", "must be > 0");
+  require(min_density >= 1 && max_density >= min_density, "min_density/max_density",
+          "must satisfy 1 ≤ min_density ≤ max_density");
+  require(max_cameras >= 2, "max_cameras", "must be ≥ 2 (a stereo pair)");
+  require(min_samples >= 3, "min_samples", "must be ≥ 3");
+  require(image_sigma >= 0, "image_sigma", "must be ≥ 0");
+  require(ncc_epsilon >= 0, "ncc_epsilon", "must be ≥ 0");
+  require(ncc_loss_scale >= 0, "ncc_loss_scale", "must be ≥ 0");
+  require(temporal_weight >= 0 && silhouette_weight >= 0 && membrane_weight >= 0 &&
+              temporal_smoothness >= 0 && damping >= 0,
+          "weights", "must be ≥ 0");
+  require(min_patch_area > 0, "min_patch_area", "must be > 0 (pixels²)");
+  require(angle_weight_power >= 0, "angle_weight_power", "must be ≥ 0");
+  require(outline_margin >= 0, "outline_margin", "must be ≥ 0 (pixels)");
+  require(max_step > 0, "max_step", "must be > 0");
+  require(adaptive_threshold >= 0, "adaptive_threshold", "must be ≥ 0");
+  solver.Check();
+  visibility.Check();
+}
+
+RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHierarchy& hierarchy,
+                              const std::vector<Positions>& control, const vision::Bounds& bounds,
+                              const StereoRefinementOptions& options, Progress* progress) {
+  const Stopwatch start;
+  options.Check();
+  images.Check("stereo refinement");
+  if (images.camera_count() < 2) ThrowError("stereo refinement", "cameras", "needs at least 2 cameras");
+  if (control.empty()) ThrowError("stereo refinement", "control", "needs at least one frame");
+  if (static_cast<int>(control.size()) != images.frame_count)
+    ThrowError("stereo refinement", "control",
+               std::to_string(control.size()) + " frames of control points for " +
+                   std::to_string(images.frame_count) + " frames of images");
+  for (std::size_t f = 0; f < control.size(); ++f)
+    if (control[f].rows() != hierarchy.VertexCount(hierarchy.finest_level()) || !control[f].allFinite())
+      ThrowError("stereo refinement", "control[" + std::to_string(f) + "]",
+                 "must have #V(finest) = " + std::to_string(hierarchy.VertexCount(hierarchy.finest_level())) +
+                     " finite rows");
+  const int finest_refined =
+      options.finest_level >= 0
+          ? options.finest_level
+          : AutomaticFinestLevel(hierarchy, control[control.size() / 2], images.cameras, options.min_patch_area);
+  if (finest_refined > hierarchy.finest_level() || options.coarsest_level > finest_refined)
+    ThrowError("stereo refinement options", "coarsest_level/finest_level",
+               "must satisfy coarsest ≤ finest ≤ " + std::to_string(hierarchy.finest_level()));
+
+  RefinementResult result;
+  result.control = control;
+  result.frames.resize(control.size());
+  for (std::size_t f = 0; f < control.size(); ++f) result.frames[f].frame = static_cast<int>(f);
+  SequenceState state{geometry::AnalyzeTrajectory(hierarchy, control), &result};
+  FrameImageCache cache(images, options.image_sigma);
+
+  const int frames = static_cast<int>(control.size());
+  const std::size_t windows = Windows(frames, options.window, options.window_overlap).size();
+  ProgressBegin(progress, "refinement",
+                static_cast<std::size_t>(finest_refined - options.coarsest_level + 1) * options.rounds * windows);
+  std::size_t done = 0;
+  std::vector<char> active(hierarchy.FaceCount(options.coarsest_level), 1);
+  for (int level = options.coarsest_level; level <= finest_refined; ++level) {
+    const std::vector<char> moved = RefineLevel(images, hierarchy, bounds, options, level, active, &cache, &state,
+                                                progress, &done);
+    if (level == finest_refined) break;
+    // Adaptivity: a child face is refined when its parent was and one of the parent's
+    // corners moved by more than the threshold at this level.
+    const geometry::Faces& F = hierarchy.LevelFaces(level);
+    std::vector<char> next(hierarchy.FaceCount(level + 1), 0);
+    for (int f = 0; f < hierarchy.FaceCount(level); ++f) {
+      const bool refine = active[f] && (moved[F(f, 0)] || moved[F(f, 1)] || moved[F(f, 2)]);
+      for (int k = 0; k < 4; ++k) next[LoopHierarchy::ChildFace(f, k)] = refine ? 1 : 0;
+    }
+    active = std::move(next);
+  }
+  ProgressEnd(progress);
+  result.seconds = start.Seconds();
+  return result;
+}
+
+}  // namespace subflow::solver

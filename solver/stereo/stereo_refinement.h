@@ -1,0 +1,178 @@
+// Spatio-temporal stereo refinement (method §4.3, eq. 25) with Ceres: the control and
+// detail trajectories of one LoopHierarchy are refined jointly over windows of frames so
+// that the images the surface patches trace agree across cameras and over time.
+//
+// Coarse to fine over the levels ℓ = coarsest_level … finest_level (section 3.4). At level
+// ℓ the unknowns are, per frame t of the window and per vertex v of level ℓ,
+//   ℓ = 0: increments of the base control points c⁰_v(t)           (world xyz, dof 3)
+//   ℓ > 0: increments of the details d(ℓ)_v(t) in the Hoppe frame   (n, r, q: dof 3, or
+//          F = (n, r, q) of C c(ℓ−1) at v                            the normal only: dof 1)
+// and the finest control points follow by synthesis c(i) = C c(i−1) + F(i) d(i), so the
+// finer details ride along in their local frames. Surface samples (about one per pixel,
+// at least min_density² per patch) are limit points of the current surface, and move
+// with the unknowns through the level-ℓ limit stencils (ncc_cost.h).
+//
+// Residuals per window (frames [w0, w1]; neighbouring frames enter as constants):
+//   * stereo: for every patch (face of level ℓ), frame t and pair (i, j) of the
+//     max_cameras cameras that see the patch best: √W(i,j) (x̂_i − x̂_j), W = (cos θ_i cos θ_j)^p
+//     (θ between the normal and the direction to the camera, p = angle_weight_power), on
+//     the samples visible in both (z-buffer visibility of the current surface);
+//   * temporal self-correlation: for each of those cameras, the patch at t against the
+//     same patch at t + 1 (eq. 25's second sum, Δt = 1): this is what refines the motion
+//     along the surface;
+//   * silhouette: every patch's middle sample projects inside every silhouette (one-sided
+//     signed distance to the outline; masks from the dataset, else the projected visual
+//     hulls);
+//   * regularization, in units of the level's mean edge length h: membrane on the
+//     increments (B_v e_v − mean of the neighbours), temporal second differences (of the
+//     details' trajectories in their local frames, which a rigid motion leaves unchanged,
+//     so only non-rigid acceleration is penalized; of the increments at level 0, whose
+//     world trajectories accelerate with the rigid motion), and a small damping;
+//   * bounds: |e| ≤ max_step · h per component, and, for the normal-only parametrization,
+//     the working volume (the paper's inequality constraints).
+// NCC blocks use a Cauchy loss (occlusions the z-buffer misses, specularities).
+//
+// Visibility and samples are recomputed `rounds` times per level as the shape changes.
+// Adaptivity: at level ℓ + 1 only the patches whose parent's corners moved by more than
+// adaptive_threshold · h_ℓ at level ℓ (in some frame) are refined; the rest keep their
+// details. The report says how much of the surface reached each level.
+//
+// The code, in the order of a level's refinement (all in solver/stereo/):
+//   level_sampling.h           the samples of a level and their limit stencils
+//   refinement_window.h        a window's frames: bases, samples' positions, visibility
+//   photometric_residuals.h    stereo, temporal self-correlation, silhouette
+//   regularization_residuals.h membrane, temporal smoothness, damping, bounds
+//   window_solve.h             one window's Ceres problem and solve → its increments
+//   stereo_refinement.cpp      levels, windows, adaptivity, applying the increments
+#pragma once
+
+#include <vector>
+
+#include <ceres/solver.h>
+
+#include "core/progress.h"
+#include "geometry/loop_hierarchy.h"
+#include "geometry/triangle_mesh.h"
+#include "solver/observation/sample_visibility.h"
+#include "vision/image_sequence.h"
+#include "vision/working_volume.h"
+
+namespace subflow::solver {
+
+// The Ceres settings of each window's solve.
+struct WindowSolverOptions {
+  // Chosen by measurement on the blob (bench/refinement_bench.cpp): sparse_normal_cholesky
+  // 9.7 s, sparse_schur 10.9 s, cgnr 11.2 s, iterative_schur 11.9 s for the same result.
+  // On the command line by Ceres's names (ceres::StringToLinearSolverType, any case).
+  ceres::LinearSolverType linear_solver = ceres::SPARSE_NORMAL_CHOLESKY;
+  int max_iterations = 8;            // Ceres iterations per window and round
+  int threads = 0;                   // 0 = all hardware threads
+  double function_tolerance = 1e-4;  // a relative cost decrease below this ends the solve
+
+  void Check() const;  // throws subflow::Error naming the field (and what Ceres objects to)
+  // ceres::Solver::Options with these settings, silent.
+  ceres::Solver::Options ToCeres() const;
+};
+
+struct StereoRefinementOptions {
+  int coarsest_level = 0;
+  // −1: automatic, the finest level whose patches still cover min_patch_area pixels² (median
+  // over the base faces of their largest projected area, divided by 4 per level, at the
+  // middle frame): a correlation window of about 4.5 × 4.5 px needs that much texture. On
+  // the blob (320×240) that is level 1 of 3; refining level 2 as well (~12 px² per patch)
+  // took twice as long for the same accuracy (0.50 against 0.46 mm P90 on frames 10–12)
+  // and end-point error.
+  int finest_level = -1;
+  double min_patch_area = 20.0;
+  // Levels ≥ this refine the normal detail only (dof 1). Tangential increments are nearly
+  // unconstrained by stereo (the correlation does not change when the surface slides along
+  // itself), so by default every level keeps the tangential motion of motion
+  // initialization and corrects the shape along the normals.
+  int normal_only_from_level = 0;
+  int window = 6;                  // frames solved jointly
+  // Frames shared by consecutive windows: the last `window_overlap` frames of a window are
+  // solved again, from their refined state, as the first frames of the next one, so that
+  // no frame is only ever refined at a window's edge (where the temporal terms see one
+  // side only). At most window − 1 is used (so --window 1 has none); windows advance by
+  // window − overlap frames.
+  // Measured on blob frames 0–11 (end-point error / accuracy P90, mm; refinement frame
+  // solves), with the level-0 term on the world trajectories: 0 → 0.0593 / 0.538 (12),
+  // 1 → 0.0536 / 0.553 (14), 2 → 0.0527 / 0.540 (16); with the increments' level-0 term
+  // as now, 0 → 0.0637 / 0.509, 2 → 0.0580 / 0.510.
+  int window_overlap = 2;
+  // Visibility/sample updates per level (visibility is recomputed at every level anyway).
+  int rounds = 1;
+  WindowSolverOptions solver;
+
+  double samples_per_pixel = 1.0;
+  int min_density = 3;   // at least min_density² samples per patch
+  int max_density = 8;
+  // Per patch: stereo pairs among the best-facing cameras (3 → 3 pairs; 4 → 6 pairs gave
+  // the same figures on the blob at twice the cost).
+  int max_cameras = 3;
+  int min_samples = 6;   // samples visible in both views of a pair
+  double image_sigma = 1.0;        // Gaussian smoothing of the images (pixels)
+  double ncc_epsilon = 0.01;       // intensity noise floor of the normalization
+  double ncc_loss_scale = 0.5;     // Cauchy scale on ‖r‖² = 2 − 2 NCC; 0 = plain squares
+  double temporal_weight = 1.0;    // self-correlation blocks, relative to stereo
+  double silhouette_weight = 0.05; // per pixel of outline distance
+  // Pair weight W(i, j) = (cos θ_i cos θ_j)^p: grazing views see the texture foreshortened
+  // and blurred along the surface, which biases the correlation optimum.
+  double angle_weight_power = 3.0;
+  // Samples closer than this to a silhouette's outline (pixels) are not correlated in that
+  // camera: their smoothed intensities mix in the background.
+  double outline_margin = 3.0;
+  double membrane_weight = 0.3;
+  double temporal_smoothness = 0.3;
+  double damping = 0.01;
+  double max_step = 1.0;           // bound on each increment, in edge lengths h
+  double adaptive_threshold = 0.02;  // in edge lengths h of the level
+  VisibilityOptions visibility;
+
+  void Check() const;  // throws subflow::Error naming the field
+};
+
+struct RefinementLevelReport {
+  int level = 0;
+  int dof = 0;
+  int patches = 0;             // faces of the level
+  int active_patches = 0;      // refined at this level (adaptivity)
+  double active_fraction = 0;  // active / all
+  int parameters = 0;          // scalar unknowns over all windows and rounds (last round)
+  int residual_blocks = 0;     // over all windows (last round)
+  int windows = 0;             // temporal windows solved per round
+  double mean_increment = 0;   // mean |B e| over vertices and frames (world units)
+  double seconds = 0;
+  double solver_seconds = 0;   // inside ceres::Solve
+  int iterations = 0;          // Ceres iterations over all windows and rounds
+};
+
+struct RefinementFrameReport {
+  int frame = 0;
+  // Mean NCC over the stereo pairs of all patches (ε-regularized), before and after.
+  double ncc_before = 0, ncc_after = 0;
+  int stereo_pairs = 0;
+  // RMS silhouette distance (pixels) of the one-sided outline term, before and after.
+  double silhouette_rms_before = 0, silhouette_rms_after = 0;
+};
+
+struct RefinementResult {
+  std::vector<geometry::Positions> control;  // finest control points per frame
+  std::vector<RefinementLevelReport> levels;
+  std::vector<RefinementFrameReport> frames;
+  double seconds = 0;
+
+  // One line: levels with their active fractions, iterations, mean NCC before → after, seconds.
+  std::string BriefReport() const;
+};
+
+// `control`: the finest control points of every frame of `images` (#V(n)×3 each,
+// motion-initialized trajectories); the images' gray frames and silhouettes (the
+// silhouette term is left out where a camera has none). Throws subflow::Error on invalid
+// options or sizes.
+RefinementResult RefineStereo(const vision::ImageSequence& images, const geometry::LoopHierarchy& hierarchy,
+                              const std::vector<geometry::Positions>& control,
+                              const vision::Bounds& bounds, const StereoRefinementOptions& options,
+                              Progress* progress = nullptr);
+
+}  // namespace subflow::solver

@@ -1,0 +1,135 @@
+#include "solver/stereo/window_solve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <ceres/ceres.h>
+#include <spdlog/spdlog.h>
+
+#include "core/stopwatch.h"
+#include "solver/stereo/photometric_residuals.h"
+#include "solver/stereo/regularization_residuals.h"
+#include "solver/stereo/stereo_refinement.h"
+
+namespace subflow::solver {
+namespace {
+
+// Per frame of the sequence: the sum and count of the figures of `records` at the current
+// parameters — per stereo pair NCC ≈ 1 − ‖r_pair‖² / (2 W) (exact for ε = 0), per
+// silhouette block the squared outline distance in pixels.
+void Evaluate(ceres::Problem& problem, const std::vector<ResidualRecord>& records, bool ncc,
+              double silhouette_weight, int frames, std::vector<double>* sum, std::vector<int>* count) {
+  sum->assign(frames, 0.0);
+  count->assign(frames, 0);
+  Eigen::VectorXd r;
+  for (const ResidualRecord& record : records) {
+    double cost = 0.0;
+    r.resize(problem.GetCostFunctionForResidualBlock(record.id)->num_residuals());
+    problem.EvaluateResidualBlock(record.id, false, &cost, r.data(), nullptr);
+    if (ncc) {
+      int offset = 0;
+      for (const CorrelationPair& pair : record.correlation->pairs()) {
+        const int n = static_cast<int>(pair.rows.size());
+        if (pair.weight > 0) {
+          (*sum)[record.frame] += 1.0 - r.segment(offset, n).squaredNorm() / (2.0 * pair.weight);
+          ++(*count)[record.frame];
+        }
+        offset += n;
+      }
+      continue;
+    }
+    (*sum)[record.frame] += std::pow(std::max(0.0, r(0)) / silhouette_weight, 2);
+    ++(*count)[record.frame];
+  }
+}
+
+// Every residual family over the window, patch by patch and then vertex by vertex.
+void BuildResiduals(RefinementWindow& window, ceres::LossFunction* ncc_loss, ceres::Problem* problem,
+                    std::vector<ResidualRecord>* stereo, std::vector<ResidualRecord>* silhouette) {
+  const int faces = static_cast<int>(window.active_faces.size());
+  for (int t = window.first; t <= window.last; ++t) {
+    for (int f = 0; f < faces; ++f) {
+      if (!window.active_faces[f]) continue;
+      const PatchCameras seen = CamerasOfPatch(window, t, f);
+      if (auto record = AddStereoResidual(window, t, f, seen, ncc_loss, problem)) stereo->push_back(*record);
+      AddTemporalResiduals(window, t, f, seen, ncc_loss, problem);
+      AddSilhouetteResiduals(window, t, f, problem, silhouette);
+    }
+  }
+  const int vertices = static_cast<int>(window.active_vertices.size());
+  for (int t = window.first; t <= window.last; ++t) {
+    for (int v = 0; v < vertices; ++v) {
+      if (!window.active_vertices[v]) continue;
+      AddMembraneResidual(window, t, v, problem);
+      AddTemporalSmoothnessResidual(window, t, v, problem);
+      AddDampingResidual(window, t, v, problem);
+    }
+  }
+}
+
+}  // namespace
+
+WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bounds) {
+  const StereoRefinementOptions& options = *window.options;
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  std::unique_ptr<ceres::LossFunction> ncc_loss;
+  if (options.ncc_loss_scale > 0) ncc_loss = std::make_unique<ceres::CauchyLoss>(options.ncc_loss_scale);
+
+  std::vector<ResidualRecord> stereo, silhouette;
+  BuildResiduals(window, ncc_loss.get(), &problem, &stereo, &silhouette);
+  WindowSolution solution;
+  solution.first = window.first;
+  solution.last = window.last;
+  solution.parameters = BoundIncrements(window, bounds, &problem);
+  solution.residual_blocks = problem.NumResidualBlocks();
+
+  const int frames = window.frame_count;
+  std::vector<double> ncc_before, silhouette_before, ncc_after, silhouette_after;
+  std::vector<int> ncc_count, silhouette_count;
+  Evaluate(problem, stereo, true, options.silhouette_weight, frames, &ncc_before, &ncc_count);
+  Evaluate(problem, silhouette, false, options.silhouette_weight, frames, &silhouette_before, &silhouette_count);
+  if (problem.NumParameterBlocks() > 0 && problem.NumResidualBlocks() > 0) {
+    ceres::Solver::Summary summary;
+    const Stopwatch solve_start;
+    ceres::Solve(options.solver.ToCeres(), &problem, &summary);
+    solution.solver_seconds = solve_start.Seconds();
+    solution.iterations = static_cast<int>(summary.iterations.size());
+    spdlog::debug("refinement level {} frames {}–{}: {}; jacobians {:.2f} s, residuals {:.2f} s, "
+                  "linear solver {:.2f} s", window.level, window.first, window.last, summary.BriefReport(),
+                  summary.jacobian_evaluation_time_in_seconds, summary.residual_evaluation_time_in_seconds,
+                  summary.linear_solver_time_in_seconds);
+  }
+  Evaluate(problem, stereo, true, options.silhouette_weight, frames, &ncc_after, &ncc_count);
+  Evaluate(problem, silhouette, false, options.silhouette_weight, frames, &silhouette_after, &silhouette_count);
+
+  const int vertices = static_cast<int>(window.active_vertices.size());
+  for (int t = window.first; t <= window.last; ++t) {
+    const FrameState& state = window.states.at(t);
+    WindowSolution::Increments e = Eigen::Map<const WindowSolution::Increments>(state.increments.data(), vertices,
+                                                                                window.dof);
+    geometry::Positions world(vertices, 3);
+    for (int v = 0; v < vertices; ++v) {
+      Eigen::Vector3d moved = Eigen::Vector3d::Zero();
+      for (int d = 0; d < window.dof; ++d) moved += e(v, d) * state.basis[v].col(d);
+      world.row(v) = moved.transpose();
+    }
+    solution.increments.push_back(std::move(e));
+    solution.displacement.push_back(std::move(world));
+    WindowFrameFigures figures;
+    figures.frame = t;
+    figures.stereo_pairs = ncc_count[t];
+    if (ncc_count[t] > 0) {
+      figures.ncc_before = ncc_before[t] / ncc_count[t];
+      figures.ncc_after = ncc_after[t] / ncc_count[t];
+      figures.silhouette_rms_before = silhouette_count[t] ? std::sqrt(silhouette_before[t] / silhouette_count[t]) : 0.0;
+      figures.silhouette_rms_after = silhouette_count[t] ? std::sqrt(silhouette_after[t] / silhouette_count[t]) : 0.0;
+    }
+    solution.frames.push_back(figures);
+  }
+  return solution;
+}
+
+}  // namespace subflow::solver

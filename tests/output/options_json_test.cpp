@@ -1,0 +1,92 @@
+// report.json records every field of every options struct (output/options_json.h): the
+// number of keys written equals the number of fields of the struct, counted by the
+// largest brace initializer the aggregate accepts, so a field added to a struct without
+// adding it to the report fails here. Recorded options read back to the same values.
+#include <cstddef>
+#include <utility>
+
+#include <gtest/gtest.h>
+
+#include "output/options_json.h"
+
+namespace subflow::output {
+namespace {
+
+// Converts to anything: one initializer of any field.
+struct AnyField {
+  template <typename T>
+  constexpr operator T() const;  // declared only: used in unevaluated contexts
+};
+
+template <typename T, typename... Fields>
+constexpr auto BraceInitializable(int) -> decltype(T{std::declval<Fields>()...}, true) {
+  return true;
+}
+template <typename T, typename... Fields>
+constexpr bool BraceInitializable(...) {
+  return false;
+}
+template <typename T, std::size_t... I>
+constexpr bool InitializableWith(std::index_sequence<I...>) {
+  return BraceInitializable<T, decltype((void)I, AnyField{})...>(0);
+}
+// The number of fields of the aggregate T (nested aggregates count as one field).
+template <typename T, std::size_t N = 0>
+constexpr std::size_t FieldCount() {
+  if constexpr (InitializableWith<T>(std::make_index_sequence<N + 1>{}))
+    return FieldCount<T, N + 1>();
+  else
+    return N;
+}
+
+struct Three {
+  int a = 0;
+  std::vector<double> b;
+  vision::SilhouetteOptions c;
+};
+static_assert(FieldCount<Three>() == 3, "the field counter counts nested aggregates once");
+
+template <typename Options>
+void ExpectEveryFieldRecorded(const char* name) {
+  const nlohmann::json json = Options{};
+  EXPECT_TRUE(json.is_object()) << name;
+  EXPECT_EQ(json.size(), FieldCount<Options>()) << name << ": " << json.dump();
+  // Read back: the same record.
+  EXPECT_EQ(nlohmann::json(json.get<Options>()), json) << name;
+}
+
+TEST(OptionsJson, EveryFieldOfEveryOptionsStructIsRecordedAndReadsBack) {
+  ExpectEveryFieldRecorded<vision::SilhouetteOptions>("SilhouetteOptions");
+  ExpectEveryFieldRecorded<vision::VoxelCarvingOptions>("VoxelCarvingOptions");
+  ExpectEveryFieldRecorded<geometry::IsosurfaceOptions>("IsosurfaceOptions");
+  ExpectEveryFieldRecorded<geometry::SimplifyOptions>("SimplifyOptions");
+  ExpectEveryFieldRecorded<solver::HierarchyFitOptions>("HierarchyFitOptions");
+  ExpectEveryFieldRecorded<solver::ShapeInitOptions>("ShapeInitOptions");
+  ExpectEveryFieldRecorded<solver::SurfaceSamplingOptions>("SurfaceSamplingOptions");
+  ExpectEveryFieldRecorded<solver::VisibilityOptions>("VisibilityOptions");
+  ExpectEveryFieldRecorded<solver::NormalFlowSolverOptions>("NormalFlowSolverOptions");
+  ExpectEveryFieldRecorded<solver::MotionStepOptions>("MotionStepOptions");
+  ExpectEveryFieldRecorded<solver::MotionInitOptions>("MotionInitOptions");
+  ExpectEveryFieldRecorded<solver::WindowSolverOptions>("WindowSolverOptions");
+  ExpectEveryFieldRecorded<solver::StereoRefinementOptions>("StereoRefinementOptions");
+  ExpectEveryFieldRecorded<solver::ReconstructionOptions>("ReconstructionOptions");
+}
+
+TEST(OptionsJson, EnumsAreRecordedByTheirCommandLineNames) {
+  solver::ReconstructionOptions options;
+  options.shape.silhouettes.source = vision::EvidenceSource::kBackground;
+  options.refinement.solver.linear_solver = ceres::ITERATIVE_SCHUR;
+  const nlohmann::json json = options;
+  EXPECT_EQ(json.at("shape_init").at("silhouettes").at("source"), "background");
+  EXPECT_EQ(json.at("shape_init").at("silhouettes").at("background_method"), "triangle");
+  EXPECT_EQ(json.at("refinement").at("solver").at("linear_solver"), "iterative_schur");
+  nlohmann::json bad = json;
+  bad["refinement"]["solver"]["linear_solver"] = "magic";
+  EXPECT_THROW(bad.get<solver::ReconstructionOptions>(), Error);
+  bad = json;
+  bad["shape_init"]["silhouettes"]["motion_method"] = "median";
+  EXPECT_THROW(bad.get<solver::ReconstructionOptions>(), Error);
+}
+
+}  // namespace
+}  // namespace subflow::output

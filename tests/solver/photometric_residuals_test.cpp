@@ -1,0 +1,168 @@
+// The photometric residual families of the stereo refinement
+// (solver/stereo/photometric_residuals.h), each on its own, on exact synthetic images of a
+// static scene (tests/solver/refinement_test_scene.h): stereo blocks measure agreement
+// between cameras, temporal blocks between frames, silhouette blocks the outline.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "solver/stereo/photometric_residuals.h"
+#include "tests/solver/refinement_test_scene.h"
+
+namespace subflow::solver {
+namespace {
+
+using testing::OpenedWindow;
+using testing::Scene;
+
+ceres::Problem::Options NoLossOwnership() {
+  ceres::Problem::Options options;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  return options;
+}
+
+// Mean NCC over the pairs of the stereo blocks at the window's current increments
+// (NCC = 1 − ‖r_pair‖² / (2 W), exact for ε = 0).
+double MeanStereoNcc(ceres::Problem& problem, const std::vector<ResidualRecord>& records) {
+  double sum = 0.0;
+  int count = 0;
+  for (const ResidualRecord& record : records) {
+    Eigen::VectorXd r(problem.GetCostFunctionForResidualBlock(record.id)->num_residuals());
+    double cost = 0.0;
+    problem.EvaluateResidualBlock(record.id, false, &cost, r.data(), nullptr);
+    int offset = 0;
+    for (const CorrelationPair& pair : record.correlation->pairs()) {
+      const int n = static_cast<int>(pair.rows.size());
+      sum += 1.0 - r.segment(offset, n).squaredNorm() / (2.0 * pair.weight);
+      ++count;
+      offset += n;
+    }
+  }
+  return sum / count;
+}
+
+TEST(CamerasOfPatch, RanksAtMostMaxCamerasByFacing) {
+  StereoRefinementOptions options;
+  options.ncc_epsilon = 0.0;
+  OpenedWindow opened(Scene(), Scene().scene.control, 1, 0, 0, 0, options);
+  int seen_by_two = 0;
+  for (int f = 0; f < Scene().scene.hierarchy.FaceCount(0); ++f) {
+    const PatchCameras seen = CamerasOfPatch(opened.window, 0, f);
+    ASSERT_LE(seen.cameras.size(), 3u);
+    ASSERT_EQ(seen.cameras.size(), seen.cosines.size());
+    EXPECT_TRUE(std::is_sorted(seen.cosines.rbegin(), seen.cosines.rend())) << "face " << f;
+    for (double cosine : seen.cosines) EXPECT_GT(cosine, 0.0);
+    seen_by_two += seen.cameras.size() >= 2;
+  }
+  // The dome of cameras looks at the upper half of the object.
+  EXPECT_GT(seen_by_two, Scene().scene.hierarchy.FaceCount(0) / 3);
+}
+
+// At the true shape the cameras agree (NCC near 1); 1.5 mm along the normals (about one
+// pixel), they agree less. ε = 0 so that the NCC read off the residual is exact.
+TEST(StereoResidual, CamerasAgreeAtTheTrueShapeAndLessOffIt) {
+  StereoRefinementOptions options;
+  options.ncc_epsilon = 0.0;
+  OpenedWindow opened(Scene(), Scene().scene.control, 1, 0, 0, 0, options);
+  RefinementWindow& window = opened.window;
+  ceres::Problem problem(NoLossOwnership());
+  std::vector<ResidualRecord> records;
+  const int faces = Scene().scene.hierarchy.FaceCount(0);
+  int stereo_patches = 0;  // patches with a pair of cameras
+  for (int f = 0; f < faces; ++f) {
+    const PatchCameras seen = CamerasOfPatch(window, 0, f);
+    stereo_patches += seen.cameras.size() >= 2;
+    if (auto record = AddStereoResidual(window, 0, f, seen, nullptr, &problem)) {
+      EXPECT_LE(record->correlation->pairs().size(), 3u);  // pairs of the 3 best cameras
+      EXPECT_EQ(record->frame, 0);
+      std::vector<double*> blocks;
+      problem.GetParameterBlocksForResidualBlock(record->id, &blocks);
+      EXPECT_EQ(blocks.size(), window.sampling->support[f].size());  // the patch's support, frame 0
+      records.push_back(*record);
+    }
+  }
+  EXPECT_GE(records.size(), 0.9 * stereo_patches);  // a block unless no pair shares min_samples
+  EXPECT_GT(stereo_patches, faces / 3);
+  const double at_truth = MeanStereoNcc(problem, records);
+  EXPECT_GT(at_truth, 0.95);  // measured 0.976
+  for (auto& [frame, state] : window.states) std::fill(state.increments.begin(), state.increments.end(), 0.0015);
+  const double off = MeanStereoNcc(problem, records);
+  std::printf("mean NCC of %zu stereo blocks: %.4f at the truth, %.4f 1.5 mm off\n", records.size(), at_truth, off);
+  EXPECT_LT(off, at_truth - 0.05) << at_truth << " -> " << off;
+}
+
+// The same images at every frame and the same surface: each temporal block compares a
+// camera's view of the patch with itself, so its residual is exactly zero; the window's
+// first frame (when not the sequence's) has a step back as well as forward.
+TEST(TemporalResiduals, VanishOnAStaticSceneWithStepsForwardAndBackAtTheWindowStart) {
+  OpenedWindow opened(Scene(), Scene().scene.control, 3, 0, 1, 1);
+  RefinementWindow& window = opened.window;
+  ceres::Problem problem(NoLossOwnership());
+  int blocks = 0, patches = 0;
+  const int faces = Scene().scene.hierarchy.FaceCount(0);
+  for (int f = 0; f < faces; ++f) {
+    const PatchCameras seen = CamerasOfPatch(window, 1, f);
+    const int added = AddTemporalResiduals(window, 1, f, seen, nullptr, &problem);
+    EXPECT_LE(added, 2);
+    blocks += added;
+    patches += !seen.cameras.empty();
+  }
+  EXPECT_EQ(blocks, 2 * patches);  // (1, 2) and (0, 1) for every patch seen at all
+  double cost = -1.0;
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
+  EXPECT_EQ(cost, 0.0);
+
+  // Off: no block.
+  StereoRefinementOptions off;
+  off.temporal_weight = 0.0;
+  OpenedWindow without(Scene(), Scene().scene.control, 3, 0, 1, 1, off);
+  ceres::Problem empty(NoLossOwnership());
+  for (int f = 0; f < faces; ++f)
+    EXPECT_EQ(AddTemporalResiduals(without.window, 1, f, CamerasOfPatch(without.window, 1, f), nullptr, &empty), 0);
+}
+
+int SilhouetteBlocks(const std::vector<cv::Mat>& masks, double* mean_residual) {
+  OpenedWindow opened(Scene(), Scene().scene.control, 1, 0, 0, 0, {}, &masks);
+  ceres::Problem problem(NoLossOwnership());
+  std::vector<ResidualRecord> records;
+  for (int f = 0; f < Scene().scene.hierarchy.FaceCount(0); ++f)
+    AddSilhouetteResiduals(opened.window, 0, f, &problem, &records);
+  double sum = 0.0;
+  for (const ResidualRecord& record : records) {
+    EXPECT_EQ(record.correlation, nullptr);
+    double r = 0.0, cost = 0.0;
+    problem.EvaluateResidualBlock(record.id, false, &cost, &r, nullptr);
+    EXPECT_GE(r, 0.0);  // one-sided
+    sum += r;
+  }
+  *mean_residual = records.empty() ? 0.0 : sum / records.size();
+  return static_cast<int>(records.size());
+}
+
+// One-sided: masks grown by 8 px leave every patch inside (no block); the exact masks
+// give blocks only along the outline, with residuals of a fraction of a pixel; masks
+// shrunk by 8 px leave many patches outside, with residuals of pixels.
+TEST(SilhouetteResiduals, OnlyWhereThePatchReachesTheOutline) {
+  const double weight = StereoRefinementOptions().silhouette_weight;
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(17, 17));
+  std::vector<cv::Mat> grown, shrunk;
+  for (const cv::Mat& mask : Scene().masks) {
+    grown.emplace_back();
+    shrunk.emplace_back();
+    cv::dilate(mask, grown.back(), kernel);
+    cv::erode(mask, shrunk.back(), kernel);
+  }
+  double mean_grown = 0, mean_exact = 0, mean_shrunk = 0;
+  EXPECT_EQ(SilhouetteBlocks(grown, &mean_grown), 0);
+  const int exact = SilhouetteBlocks(Scene().masks, &mean_exact);
+  const int outside = SilhouetteBlocks(shrunk, &mean_shrunk);
+  EXPECT_GT(outside, 2 * exact);
+  EXPECT_LT(mean_exact, 1.0 * weight);   // < 1 px
+  EXPECT_GT(mean_shrunk, 2.0 * weight);  // > 2 px
+}
+
+}  // namespace
+}  // namespace subflow::solver

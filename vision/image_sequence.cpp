@@ -1,0 +1,50 @@
+#include "vision/image_sequence.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "vision/dataset.h"
+#include "vision/zbuffer.h"
+
+namespace subflow::vision {
+
+void ImageSequence::Check(const std::string& stage) const {
+  if (cameras.empty()) ThrowError(stage, "cameras", "needs at least one camera");
+  if (frame_count < 1) ThrowError(stage, "frames", "needs at least one frame");
+  if (!gray) ThrowError(stage, "gray images", "no image loader given");
+}
+
+cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolation) {
+  return camera.HasDistortion() ? camera.UndistortImage(image, interpolation) : image;
+}
+
+ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,
+                            EvidenceSource evidence, const std::vector<geometry::TriangleMesh>* hulls) {
+  if (first_frame < 0 || frame_count < 1 || first_frame + frame_count > dataset.frame_count())
+    ThrowError(dataset.directory(), "frames",
+               "window [" + std::to_string(first_frame) + ", " + std::to_string(first_frame + frame_count) +
+                   ") is not inside the dataset's " + std::to_string(dataset.frame_count()) + " frames");
+  if (hulls && static_cast<int>(hulls->size()) != frame_count)
+    ThrowError(dataset.directory(), "hulls",
+               std::to_string(hulls->size()) + " visual hulls for " + std::to_string(frame_count) + " frames");
+  ImageSequence sequence;
+  sequence.cameras = dataset.cameras();
+  sequence.first_frame = first_frame;
+  sequence.frame_count = frame_count;
+  sequence.gray = [&dataset, first_frame](int camera, int frame) {
+    return Undistorted(dataset.camera(camera), dataset.Gray(camera, first_frame + frame), cv::INTER_LINEAR);
+  };
+  std::vector<bool> masks(dataset.camera_count());
+  for (int k = 0; k < dataset.camera_count(); ++k)
+    masks[k] = (evidence == EvidenceSource::kAuto ? AutomaticSource(dataset, k) : evidence) == EvidenceSource::kMask;
+  sequence.silhouette = [&dataset, first_frame, hulls, masks](int camera, int frame) {
+    if (masks[camera])
+      return Undistorted(dataset.camera(camera), dataset.Mask(camera, first_frame + frame), cv::INTER_NEAREST);
+    if (!hulls || (*hulls)[frame].F.rows() == 0) return cv::Mat();
+    const geometry::TriangleMesh& hull = (*hulls)[frame];
+    return ZBuffer(dataset.camera(camera), hull.V, hull.F).Mask();
+  };
+  return sequence;
+}
+
+}  // namespace subflow::vision
