@@ -15,7 +15,7 @@
 
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
-#include "cli/report_json.h"
+#include "output/report.h"
 #include "core/error.h"
 #include "core/stopwatch.h"
 #include "geometry/mesh_io.h"
@@ -123,7 +123,7 @@ void RunExport(const ExportArguments& arguments) {
       sequence ? (fs::path(arguments.out) / "report.json").string() : arguments.out + ".report.json";
   if (!sequence) output::CheckOutputPath(report_path, true);
   output::WriteJsonFile(report_path, {{"command", "export"},
-                                      {"versions", VersionsJson()},
+                                      {"versions", output::VersionsJson()},
                                       {"result", arguments.result},
                                       {"format", format},
                                       {"out", arguments.out},

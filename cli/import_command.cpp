@@ -11,7 +11,7 @@
 
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
-#include "cli/report_json.h"
+#include "output/report.h"
 #include "core/error.h"
 #include "core/stopwatch.h"
 #include "output/result_writer.h"
@@ -70,9 +70,9 @@ nlohmann::json ImportReport(const ImportArguments& arguments, const vision::Data
           {"skipped_cameras", result.skipped_cameras},
           {"unused_entries", result.unused_entries},
           {"notes", result.notes},
-          {"dataset", DatasetJson(dataset)},
+          {"dataset", output::DatasetJson(dataset)},
           {"seconds", seconds},
-          {"versions", VersionsJson()}};
+          {"versions", output::VersionsJson()}};
 }
 
 // <out>/preview/<camera>.png: frame 0 with the volume, the floor grid and the axes.

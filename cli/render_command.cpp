@@ -9,7 +9,7 @@
 
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
-#include "cli/report_json.h"
+#include "output/report.h"
 #include "core/stopwatch.h"
 #include "output/result_metadata.h"
 #include "output/result_pictures.h"
@@ -46,7 +46,7 @@ void RunRender(const RenderArguments& arguments) {
       output::RenderResultPictures(result, dataset.get(), metadata, arguments.out, options, &progress);
   nlohmann::json report = summary.Json();
   report["command"] = "render";
-  report["versions"] = VersionsJson();
+  report["versions"] = output::VersionsJson();
   report["result"] = arguments.result;
   report["dataset"] = metadata.dataset_directory;
   report["fps"] = metadata.fps;

@@ -7,7 +7,7 @@
 
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
-#include "cli/report_json.h"
+#include "output/report.h"
 #include "core/stopwatch.h"
 #include "output/output_file.h"
 #include "output/result_metadata.h"
@@ -42,7 +42,7 @@ void RunView(const ViewArguments& arguments) {
   const output::ViewerSummary summary =
       output::WriteViewer(result, dataset.get(), metadata, arguments.out, options, &progress);
   output::WriteJsonFile(arguments.out + ".report.json", {{"command", "view"},
-                                                         {"versions", VersionsJson()},
+                                                         {"versions", output::VersionsJson()},
                                                          {"result", arguments.result},
                                                          {"dataset", metadata.dataset_directory},
                                                          {"out", arguments.out},
