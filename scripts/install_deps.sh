@@ -14,6 +14,7 @@ packages=(
   libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmesh-dev  # optional reference in bench/subdivision_bench
+  clang libclang-rt-14-dev  # the fuzz harnesses (libFuzzer, ASan, UBSan): scripts/fuzz.sh
 )
 
 missing=()

@@ -252,7 +252,8 @@ Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const Estimat
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
                              const SilhouetteOptions& options, int open_radius = 0);
 
-// Whether `silhouettes` say nothing about where the object is: every camera uses motion
+// Whether `silhouettes` say nothing about where the object is: every silhouette is empty
+// (the object has left the working volume in that frame), or every camera uses motion
 // evidence and fewer than `min_cameras` of them have a non-empty silhouette (a frame of a
 // mask-less dataset in which nothing moves within the motion window).
 bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras = 1);
