@@ -24,6 +24,8 @@ Command AddEvalCommand(CLI::App& app);   // cli/eval_command.cpp
 Command AddSubdivideCommand(CLI::App& app);  // cli/subdivide_command.cpp
 Command AddHullCommand(CLI::App& app);       // cli/hull_command.cpp
 Command AddReconstructCommand(CLI::App& app);  // cli/reconstruct_command.cpp
+Command AddExportCommand(CLI::App& app);       // cli/export_command.cpp
+Command AddImportCommand(CLI::App& app);       // cli/import_command.cpp
 
 inline std::vector<AddCommandFunction> AllCommands() {
   return {
@@ -33,6 +35,8 @@ inline std::vector<AddCommandFunction> AllCommands() {
       AddSubdivideCommand,
       AddHullCommand,
       AddReconstructCommand,
+      AddExportCommand,
+      AddImportCommand,
   };
 }
 

@@ -28,6 +28,7 @@ struct EvalSettings {
   std::string dataset, result, json_path;
   bool overwrite = false;
   vision::EvaluationOptions options;
+  bool hull = false;  // score RESULT/hull/ (visual hulls) instead of RESULT/meshes/
 };
 
 Eigen::Matrix3d CayleyRotation(const Eigen::Vector3d& w) {
@@ -83,9 +84,11 @@ void RunEval(const EvalSettings& settings) {
   if (!settings.json_path.empty()) output::CheckOutputFile(settings.json_path, settings.overwrite, "--json");
   ProgressBar progress;
   const vision::EvaluationReport report =
-      vision::EvaluateReconstruction(settings.dataset, settings.result, settings.options, &progress);
+      vision::EvaluateReconstruction(settings.dataset, settings.result, settings.options, &progress,
+                                     settings.hull ? "hull" : "meshes");
   std::cout << report.Table();
-  const nlohmann::json rigid = RigidComparison(settings.dataset, settings.result);
+  const nlohmann::json rigid =
+      settings.hull ? nlohmann::json::array() : RigidComparison(settings.dataset, settings.result);
   if (!rigid.empty()) {
     double worst = 0.0, sum = 0.0;
     for (const auto& step : rigid) {
@@ -117,7 +120,7 @@ Command AddEvalCommand(CLI::App& app) {
   auto settings = std::make_shared<EvalSettings>();
   CLI::App* command = app.add_subcommand(
       "eval", "Score a reconstruction against ground truth: accuracy, completeness, Chamfer, Hausdorff, "
-              "scene-flow end-point error");
+              "scene-flow end-point error, on the whole and on the observed surface (seen by --min-views cameras)");
   command->add_option("dataset", settings->dataset, "Dataset directory (with groundtruth/mesh/)")->required();
   command->add_option("result", settings->result, "Result directory (with meshes/)")->required();
   command->add_option("--json", settings->json_path,
@@ -128,6 +131,14 @@ Command AddEvalCommand(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--samples", settings->options.samples, "Area-weighted samples per surface and frame")
       ->capture_default_str();
+  command->add_option("--min-views", settings->options.min_views,
+                      "Observed surface: true surface seen by at least this many cameras (z-buffer visibility)")
+      ->capture_default_str();
+  command->add_option("--visibility-tolerance", settings->options.visibility_tolerance,
+                      "Depth tolerance of the visibility test (world units); 0 = 0.25 % of the true bbox diagonal")
+      ->capture_default_str();
+  command->add_flag("--hull", settings->hull,
+                    "Score RESULT/hull/ (the visual hulls of `subflow hull`) instead of RESULT/meshes/: surfaces only");
   return {command, [settings] { RunEval(*settings); }};
 }
 

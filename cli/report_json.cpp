@@ -1,6 +1,7 @@
 #include "cli/report_json.h"
 
 #include <cmath>
+#include <filesystem>
 
 #include <CGAL/version.h>
 #include <Eigen/Core>
@@ -31,8 +32,11 @@ nlohmann::json DatasetJson(const vision::Dataset& dataset) {
   nlohmann::json cameras = nlohmann::json::array();
   for (const auto& camera : dataset.cameras())
     cameras.push_back({{"name", camera.name()}, {"width", camera.width()}, {"height", camera.height()}});
-  return {{"directory", dataset.directory()},
+  // fps and units are what the exports need to play and label the result (null = absent).
+  return {{"directory", std::filesystem::absolute(dataset.directory()).lexically_normal().string()},
           {"frames", dataset.frame_count()},
+          {"fps", dataset.fps() ? nlohmann::json(*dataset.fps()) : nlohmann::json()},
+          {"units", dataset.units().empty() ? nlohmann::json() : nlohmann::json(dataset.units())},
           {"cameras", cameras},
           {"bounds", {{"min", Vector3(dataset.bounds().min)}, {"max", Vector3(dataset.bounds().max)},
                       {"from_file", dataset.bounds_from_file()}}},

@@ -17,15 +17,16 @@ Command AddSynthCommand(CLI::App& app) {
   auto options = std::make_shared<vision::SynthOptions>();
   auto out = std::make_shared<std::string>();
   CLI::App* command = app.add_subcommand(
-      "synth", "Render a synthetic dataset (blob, rigid, head or sphere) with ground-truth meshes");
-  command->add_option("scene", options->scene.scene, "Scene: blob, rigid, head or sphere")
+      "synth", "Render a synthetic dataset with ground-truth meshes (blob, rigid, head, sphere, bust, mug, pair, critter)");
+  command->add_option("scene", options->scene.scene,
+                      "Scene: blob, rigid, head, sphere (icospheres) or bust, mug, pair, critter (SDF subjects)")
       ->required()
       ->check(CLI::IsMember(vision::SyntheticSceneNames()));
   command->add_option("--out,-o", *out, "Output dataset directory (new or empty)")->required();
   command->add_option("--cameras", options->rig.camera_count, "Number of cameras")
       ->capture_default_str();
-  command->add_option("--rig", options->rig.rig, "Camera rig: ring, dome or partial-dome")
-      ->check(CLI::IsMember({"ring", "dome", "partial-dome"}))
+  command->add_option("--rig", options->rig.rig, "Camera rig: ring, dome, partial-dome or front (front half only)")
+      ->check(CLI::IsMember({"ring", "dome", "partial-dome", "front"}))
       ->capture_default_str();
   command->add_option("--width", options->rig.width, "Image width (px)")->capture_default_str();
   command->add_option("--height", options->rig.height, "Image height (px)")->capture_default_str();
@@ -34,6 +35,12 @@ Command AddSynthCommand(CLI::App& app) {
   command->add_option("--distance", options->rig.distance, "Camera distance to the object (m)")
       ->capture_default_str();
   command->add_option("--frames", options->scene.frame_count, "Number of frames")->capture_default_str();
+  command->add_option("--start-frame", options->scene.start_frame,
+                      "Frame f shows the scene's frame start-frame + f (a still: --frames 1 --start-frame F)")
+      ->capture_default_str();
+  command->add_option("--voxel", options->scene.voxel_size,
+                      "SDF subjects: meshing voxel (m); the 3 mm plates need <= 0.0015")
+      ->capture_default_str();
   command->add_option("--motion", options->scene.motion, "Motion per frame, relative to the scene's default")
       ->capture_default_str();
   command->add_option("--noise", options->render.noise_sigma, "Gaussian sensor noise σ (grey levels of 255)")
@@ -49,6 +56,23 @@ Command AddSynthCommand(CLI::App& app) {
   command->add_option("--background", options->render.background, "Background: dark or texture")
       ->check(CLI::IsMember({"dark", "texture"}))
       ->capture_default_str();
+  command->add_option("--environment", options->environment.kind,
+                      "Around the subject: none, floor (textured) or room (textured floor and walls)")
+      ->check(CLI::IsMember({"none", "floor", "room"}))
+      ->capture_default_str();
+  command->add_option("--distractors", options->environment.distractors,
+                      "Moving things outside the working volume: none, walker, crosser (in front of cam00) or both")
+      ->check(CLI::IsMember({"none", "walker", "crosser", "both"}))
+      ->capture_default_str();
+  command->add_flag("--shadows", options->environment.shadows, "Soft shadows of the subject from the key light");
+  command->add_option("--distortion", options->distortion, "Lens distortion k1,k2,p1,p2,k3 of every camera")
+      ->delimiter(',')
+      ->expected(5);
+  auto no_masks = std::make_shared<bool>(false), no_background = std::make_shared<bool>(false);
+  command->add_flag("--no-masks", *no_masks, "Write no masks/ (ground truth is still written)");
+  command->add_flag("--no-background", *no_background, "Write no background/ images");
+  command->add_option("--video", options->video, "Write frames as videos/<cam>.mp4 (mp4v) instead of PNGs")
+      ->check(CLI::IsMember({"mp4"}));
   command->add_option("--subdivisions", options->scene.subdivisions, "Icosphere levels of the mesh")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Texture and noise seed")->capture_default_str();
@@ -56,7 +80,9 @@ Command AddSynthCommand(CLI::App& app) {
   command->add_flag("--gray", *all_gray, "Every camera gray (no colour cameras)")->excludes(colour_list);
   command->add_flag("--overwrite", options->overwrite, "Replace the dataset in a non-empty directory");
 
-  return {command, [options, out, colour_list, all_gray] {
+  return {command, [options, out, colour_list, all_gray, no_masks, no_background] {
+            options->write_masks = !*no_masks;
+            options->write_background = !*no_background;
             if (*all_gray) {
               options->colour_cameras.clear();
             } else if (colour_list->count() == 0) {  // the defaults, where those cameras exist

@@ -1,7 +1,7 @@
-// libFuzzer harness: the COLMAP text model importer (vision/colmap_import.h) on a fuzzed
+// libFuzzer harness: the COLMAP text model importer (vision/import_colmap.h) on a fuzzed
 // folder with cameras.txt and images.txt (fuzz/fuzz_support.h), both naming rules.
 #include "fuzz/fuzz_support.h"
-#include "vision/colmap_import.h"
+#include "vision/import_colmap.h"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   subflow::fuzz::QuietLogs();

@@ -1,8 +1,8 @@
-// libFuzzer harness: the projection-matrix importers (vision/projection_matrix_import.h) on a
+// libFuzzer harness: the projection-matrix importers (vision/import_projection_matrices.h) on a
 // fuzzed folder (fuzz/fuzz_support.h): the matrix-file folder (image sizes from the
 // images beside them, or given), and a Middlebury "<name>_par.txt" in it.
 #include "fuzz/fuzz_support.h"
-#include "vision/projection_matrix_import.h"
+#include "vision/import_projection_matrices.h"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   subflow::fuzz::QuietLogs();

@@ -12,10 +12,19 @@ packages=(
   libtet1.5-dev
   libtbb-dev
   libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
+  libtinygltf-dev
+  libpugixml-dev libtomlplusplus-dev  # calibration importers: Qualisys XML, Pose2Sim/Anipose TOML
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmesh-dev  # optional reference in bench/subdivision_bench
   clang libclang-rt-14-dev  # the fuzz harnesses (libFuzzer, ASan, UBSan): scripts/fuzz.sh
+  # Tests of the exports and the viewer: Blender reads the point caches and the .glb
+  # (python3-numpy: its glTF importer needs it), Chromium opens the viewer headless.
+  blender python3-numpy
+  chromium
 )
+# node and npm (for the viewer's three.js bundle and the glTF validator): Debian's, unless
+# the machine already has a node.
+command -v node > /dev/null 2>&1 || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -24,12 +33,21 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install_deps: all ${#packages[@]} packages present"
-  exit 0
+else
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  echo "install_deps: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "install_deps: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The viewer's npm packages (three.js, esbuild, gltf-validator), pinned by
+# viewer/package-lock.json; the build bundles three.js into the subflow binary.
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+stamp="$root/viewer/node_modules/.installed-package-lock.json"
+if ! cmp -s "$root/viewer/package-lock.json" "$stamp"; then
+  echo "install_deps: npm ci in viewer/"
+  (cd "$root/viewer" && npm ci --no-audit --no-fund --loglevel=error)
+  cp "$root/viewer/package-lock.json" "$stamp"
+fi

@@ -2,18 +2,17 @@
 
 #include <cmath>
 #include <sstream>
-#include <vector>
 
 #include <Eigen/Dense>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <spdlog/spdlog.h>
 
 #include "core/error.h"
+#include "vision/rotation.h"
 
 namespace subflow::vision {
 namespace {
-
-constexpr double kRotationTolerance = 1e-6;
 
 std::string Describe(const Eigen::MatrixXd& m) {
   std::ostringstream out;
@@ -28,26 +27,6 @@ std::string Describe(const Eigen::MatrixXd& m) {
   return out.str();
 }
 
-// The OpenCV distortion model in normalized coordinates (x, y) = (Xc.x/Xc.z, Xc.y/Xc.z).
-Eigen::Vector2d Distort(const Eigen::Matrix<double, 5, 1>& d, const Eigen::Vector2d& xy,
-                        Eigen::Matrix2d* jacobian = nullptr) {
-  const double k1 = d[0], k2 = d[1], p1 = d[2], p2 = d[3], k3 = d[4];
-  const double x = xy.x(), y = xy.y();
-  const double r2 = x * x + y * y;
-  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  Eigen::Vector2d out(x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
-                      y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y);
-  if (jacobian) {
-    const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * k3 * r2);
-    const double drad_dx = dradial_dr2 * 2 * x, drad_dy = dradial_dr2 * 2 * y;
-    (*jacobian)(0, 0) = radial + x * drad_dx + 2 * p1 * y + 6 * p2 * x;
-    (*jacobian)(0, 1) = x * drad_dy + 2 * p1 * x + 2 * p2 * y;
-    (*jacobian)(1, 0) = y * drad_dx + 2 * p1 * x + 2 * p2 * y;
-    (*jacobian)(1, 1) = radial + y * drad_dy + 6 * p1 * y + 2 * p2 * x;
-  }
-  return out;
-}
-
 cv::Mat ToCv(const Eigen::Matrix3d& m) {
   cv::Mat out(3, 3, CV_64F);
   for (int r = 0; r < 3; ++r)
@@ -59,7 +38,8 @@ cv::Mat ToCv(const Eigen::Matrix3d& m) {
 
 Camera::Camera(std::string name, int width, int height, const Eigen::Matrix3d& K,
                const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
-               const Eigen::VectorXd& distortion, const std::string& source)
+               const Eigen::VectorXd& distortion, const std::string& source,
+               DistortionModel distortion_model)
     : name_(std::move(name)), width_(width), height_(height), K_(K), R_(R), t_(t) {
   const std::string where = "camera \"" + name_ + "\"";
   auto fail = [&](const std::string& field, const std::string& problem) {
@@ -79,25 +59,27 @@ Camera::Camera(std::string name, int width, int height, const Eigen::Matrix3d& K
                   Describe(K));
   if (!(K(0, 0) > 0) || !(K(1, 1) > 0))
     fail("K", "expected focal lengths fx = K[0][0] > 0 and fy = K[1][1] > 0, got " + Describe(K));
-  if (!R.allFinite()) fail("R", "expected finite values, got " + Describe(R));
-  const double orthogonality = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
-  if (orthogonality > kRotationTolerance || std::abs(R.determinant() - 1) > kRotationTolerance) {
-    std::ostringstream problem;
-    problem << "expected a rotation (RᵀR = I and det R = +1 to " << kRotationTolerance
-            << "), got max |RᵀR − I| = " << orthogonality << ", det R = " << R.determinant()
-            << " for " << Describe(R);
-    fail("R", problem.str());
-  }
+  const NearestRotationResult rotation = NearestRotation(R, source, where + ": R");
+  R_ = rotation.rotation;
+  rotation_correction_ = rotation.correction;
+  if (rotation.correction > kRotationWarningTolerance)
+    spdlog::warn("{}{}: R is {:.3g} from a rotation (max |R − R̂| over its entries, above {:.0e}); "
+                 "using the nearest rotation R̂", source.empty() ? "" : source + ": ", where,
+                 rotation.correction, kRotationWarningTolerance);
   if (!t.allFinite()) fail("t", "expected finite values, got " + Describe(t));
+
   const int n = static_cast<int>(distortion.size());
-  if (n != 0 && n != 4 && n != 5 && n != 8)
-    fail("distortion", "expected 0, 4 (k1 k2 p1 p2), 5 (k1 k2 p1 p2 k3) or 8 values, got " +
-                           std::to_string(n));
+  distortion_.model = distortion_model;
+  if (distortion_model == DistortionModel::kFisheye) {
+    if (n != 0 && n != 4)
+      fail("distortion", "expected 0 or 4 values (fisheye k1 k2 k3 k4), got " + std::to_string(n));
+  } else if (n != 0 && n != 4 && n != 5 && n != 8) {
+    fail("distortion", "expected 0, 4 (k1 k2 p1 p2), 5 (k1 k2 p1 p2 k3) or 8 (k1 k2 p1 p2 k3 k4 k5 k6) "
+                       "values, got " + std::to_string(n));
+  }
   if (!distortion.allFinite()) fail("distortion", "expected finite values, got " + Describe(distortion));
-  if (n == 8 && distortion.tail<3>().cwiseAbs().maxCoeff() != 0)
-    fail("distortion", "the rational model's k4 k5 k6 must be 0 (subflow models k1 k2 p1 p2 k3 only), got " +
-                           Describe(distortion.transpose()));
-  for (int i = 0; i < std::min(n, 5); ++i) distortion_[i] = distortion[i];
+  for (int i = 0; i < n; ++i) distortion_.coefficients[i] = distortion[i];
+  distortion_coefficients_ = distortion_.OpenCvCoefficients();
 }
 
 Eigen::Matrix<double, 3, 4> Camera::ProjectionMatrix() const {
@@ -110,7 +92,7 @@ Eigen::Vector2d Camera::Project(const Eigen::Vector3d& X, double* depth) const {
   const Eigen::Vector3d Xc = ToCamera(X);
   if (depth) *depth = Xc.z();
   const Eigen::Vector2d normalized = Xc.head<2>() / Xc.z();
-  const Eigen::Vector2d xy = HasDistortion() ? Distort(distortion_, normalized) : normalized;
+  const Eigen::Vector2d xy = HasDistortion() ? distortion_.Distort(normalized) : normalized;
   return (K_ * xy.homogeneous()).head<2>();
 }
 
@@ -138,22 +120,10 @@ Eigen::Vector3d Camera::BackProjectUndistorted(const Eigen::Vector2d& pixel) con
 
 Eigen::Vector3d Camera::BackProject(const Eigen::Vector2d& pixel) const {
   if (!HasDistortion()) return BackProjectUndistorted(pixel);
-  // OpenCV's iterative inversion, then Newton steps on the exact model so that
-  // Project(BackProject(p)) = p to ~1e-10 px even where the iteration converges slowly.
-  std::vector<cv::Point2d> source{{pixel.x(), pixel.y()}}, normalized;
-  cv::Mat d(1, 5, CV_64F);
-  for (int i = 0; i < 5; ++i) d.at<double>(0, i) = distortion_[i];
-  cv::Mat K = ToCv(K_);
-  cv::undistortPoints(source, normalized, K, d, cv::noArray(), cv::noArray(),
-                      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-14));
-  Eigen::Vector2d xy(normalized[0].x, normalized[0].y);
-  const Eigen::Vector2d target = (K_.inverse() * pixel.homogeneous()).head<2>();  // distorted normalized
-  for (int iteration = 0; iteration < 10; ++iteration) {
-    Eigen::Matrix2d jacobian;
-    const Eigen::Vector2d residual = Distort(distortion_, xy, &jacobian) - target;
-    if (residual.norm() < 1e-15) break;
-    xy -= jacobian.partialPivLu().solve(residual);
-  }
+  // The distorted normalized point, undistorted so that Project(BackProject(p)) = p to
+  // ~1e-10 px even where OpenCV's iteration converges slowly (LensDistortion::Undistort).
+  const Eigen::Vector2d target = (K_.inverse() * pixel.homogeneous()).head<2>();
+  const Eigen::Vector2d xy = distortion_.Undistort(target);
   return (R_.transpose() * xy.homogeneous()).normalized();
 }
 
@@ -169,12 +139,14 @@ cv::Mat Camera::UndistortImage(const cv::Mat& image, int interpolation) const {
                "expected a " + std::to_string(width_) + "×" + std::to_string(height_) +
                    " image, got " + std::to_string(image.cols) + "×" + std::to_string(image.rows));
   if (!HasDistortion()) return image.clone();
-  cv::Mat d(1, 5, CV_64F);
-  for (int i = 0; i < 5; ++i) d.at<double>(0, i) = distortion_[i];
+  const cv::Mat d = distortion_.OpenCvCoefficientsMat();
   const cv::Mat K = ToCv(K_);
   cv::Mat map_x, map_y;
-  cv::initUndistortRectifyMap(K, d, cv::noArray(), K, cv::Size(width_, height_), CV_32FC1, map_x,
-                              map_y);
+  if (distortion_.model == DistortionModel::kFisheye)
+    cv::fisheye::initUndistortRectifyMap(K, d, cv::Mat::eye(3, 3, CV_64F), K, cv::Size(width_, height_),
+                                         CV_32FC1, map_x, map_y);
+  else
+    cv::initUndistortRectifyMap(K, d, cv::noArray(), K, cv::Size(width_, height_), CV_32FC1, map_x, map_y);
   cv::Mat undistorted;
   cv::remap(image, undistorted, map_x, map_y, interpolation, cv::BORDER_CONSTANT, cv::Scalar());
   return undistorted;

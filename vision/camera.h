@@ -3,15 +3,23 @@
 //   camera coordinates  Xc = R X + t   (+z forward, +x right, +y down)
 //   pixel               p = (fx Xc.x / Xc.z + cx, fy Xc.y / Xc.z + cy) (+ skew K(0,1))
 //   pixel (0, 0) is the CENTRE of the top-left pixel; P = K [R | t] (method eq. 4).
-// Distortion (k1 k2 p1 p2 k3) is applied by Project/Distort in normalized coordinates,
-// as cv::projectPoints does. The reconstruction works on undistorted images (see
-// UndistortImage), so its hot paths use ProjectUndistorted and its Jacobian.
+// Distortion (vision/lens_distortion.h: OpenCV's k1 k2 p1 p2 k3 [k4 k5 k6] or its fisheye
+// k1..k4) is applied by Project in normalized coordinates, as cv::projectPoints does. The
+// reconstruction works on undistorted images (see UndistortImage), so its hot paths use
+// ProjectUndistorted and its Jacobian.
+//
+// Calibrations as they are: R may be a near-rotation as files print it (6–8 digits); it
+// is replaced by the nearest rotation (vision/rotation.h), with a warning (spdlog) when
+// the correction exceeds kRotationWarningTolerance. Only a clear non-rotation (mirrored,
+// scaled) is an error.
 #pragma once
 
 #include <string>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+
+#include "vision/lens_distortion.h"
 
 namespace subflow::vision {
 
@@ -25,12 +33,15 @@ inline constexpr long long kMaxImagePixels = 1LL << 28;
 class Camera {
  public:
   Camera() = default;
-  // Throws subflow::Error naming `source` when K is not a valid intrinsic matrix
-  // (fx, fy > 0, last row (0, 0, 1)), R is not a rotation (RᵀR = I and det R = +1 to 1e-6),
-  // sizes are not positive, or any value is not finite.
+  // `distortion`: kOpenCV 0, 4 (k1 k2 p1 p2), 5 (+ k3) or 8 (+ k4 k5 k6) values;
+  // kFisheye 0 or 4 (k1 k2 k3 k4). Throws subflow::Error naming `source` when K is not a
+  // valid intrinsic matrix (fx, fy > 0, last row (0, 0, 1)), R is not a near-rotation
+  // (NearestRotation), sizes are not positive, the distortion has another length, or any
+  // value is not finite.
   Camera(std::string name, int width, int height, const Eigen::Matrix3d& K,
          const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
-         const Eigen::VectorXd& distortion = Eigen::VectorXd(), const std::string& source = "");
+         const Eigen::VectorXd& distortion = Eigen::VectorXd(), const std::string& source = "",
+         DistortionModel distortion_model = DistortionModel::kOpenCV);
 
   const std::string& name() const { return name_; }
   int width() const { return width_; }
@@ -38,9 +49,14 @@ class Camera {
   const Eigen::Matrix3d& K() const { return K_; }
   const Eigen::Matrix3d& R() const { return R_; }
   const Eigen::Vector3d& t() const { return t_; }
-  // k1 k2 p1 p2 k3 (5 values, zeros when the camera has none).
-  const Eigen::Matrix<double, 5, 1>& distortion() const { return distortion_; }
-  bool HasDistortion() const { return distortion_.cwiseAbs().maxCoeff() > 0; }
+  // The coefficients in OpenCV's order: kOpenCV k1 k2 p1 p2 k3 (5 values, zeros when the
+  // camera has none; 8 with k4 k5 k6 when they are not all zero), kFisheye k1 k2 k3 k4.
+  const Eigen::VectorXd& distortion() const { return distortion_coefficients_; }
+  DistortionModel distortion_model() const { return distortion_.model; }
+  const LensDistortion& lens_distortion() const { return distortion_; }
+  bool HasDistortion() const { return !distortion_.IsIdentity(); }
+  // max |R_given − R| of the re-orthonormalization (0 when R was given exactly).
+  double rotation_correction() const { return rotation_correction_; }
 
   Eigen::Vector3d Center() const { return -R_.transpose() * t_; }  // in world coordinates
   Eigen::Vector3d ViewDirection() const { return R_.row(2).transpose(); }  // optical axis
@@ -70,7 +86,9 @@ class Camera {
   Eigen::Matrix3d K_ = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t_ = Eigen::Vector3d::Zero();
-  Eigen::Matrix<double, 5, 1> distortion_ = Eigen::Matrix<double, 5, 1>::Zero();
+  LensDistortion distortion_;
+  Eigen::VectorXd distortion_coefficients_ = Eigen::VectorXd::Zero(5);
+  double rotation_correction_ = 0;
 };
 
 }  // namespace subflow::vision

@@ -26,8 +26,8 @@ Eigen::Vector3d OnSphere(double distance, double azimuth_deg, double elevation_d
 }  // namespace
 
 void CameraRigOptions::Check() const {
-  if (rig != "ring" && rig != "dome" && rig != "partial-dome")
-    ThrowError("camera rig", "rig", "expected ring, dome or partial-dome, got \"" + rig + "\"");
+  if (rig != "ring" && rig != "dome" && rig != "partial-dome" && rig != "front")
+    ThrowError("camera rig", "rig", "expected ring, dome, partial-dome or front, got \"" + rig + "\"");
   if (camera_count < 2 || camera_count > 100)
     ThrowError("camera rig", "cameras", "expected 2..100, got " + std::to_string(camera_count));
   if (width < 8 || height < 8 || width > 8192 || height > 8192)
@@ -75,6 +75,9 @@ std::vector<Camera> MakeCameraRig(const CameraRigOptions& options, const Eigen::
     for (int k = 0; k < low; ++k) add(-90.0 + 360.0 * k / low, options.elevation_deg, focal);
     for (int k = 0; k < high; ++k) add(-90.0 + 360.0 * (k + 0.5) / high, 50.0, focal);
     add(0.0, 90.0, focal);
+  } else if (options.rig == "front") {
+    for (int k = 0; k < n; ++k)
+      add(-165.0 + 150.0 * k / (n - 1), options.elevation_deg + (k % 2 == 0 ? 0.0 : 25.0), focal);
   } else {  // partial-dome: the front half of the azimuths, two elevations
     const int low = (n + 1) / 2, high = n - low;
     for (int k = 0; k < low; ++k) {

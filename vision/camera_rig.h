@@ -11,6 +11,9 @@
 //                 half (−180°..0°, centred on −90°), and every third camera has a
 //                 narrower field of view (focal × narrow_focal_factor): it sees only part
 //                 of the working volume.
+//   front         every camera in front of the subject (the −y side): azimuths evenly
+//                 from −165° to −15°, elevations alternating elevation_deg and
+//                 elevation_deg + 25°, one focal length: nothing sees the back half.
 // The look-at frame: z = (target − C)/|·|, x = z × up / |·| (up = +z, or +y when looking
 // straight down), y = z × x; R has rows x, y, z and t = −R C. Principal point at the
 // image centre ((W − 1)/2, (H − 1)/2), square pixels.
@@ -26,7 +29,7 @@
 namespace subflow::vision {
 
 struct CameraRigOptions {
-  std::string rig = "ring";      // "ring", "dome" or "partial-dome"
+  std::string rig = "ring";      // "ring", "dome", "partial-dome" or "front"
   int camera_count = 10;
   int width = 320, height = 240;
   double focal = 0.0;            // px; 0 = 420 × width / 320 (the blob dataset's field of view)

@@ -100,7 +100,7 @@ std::vector<Camera> ReadCamerasJson(const std::string& path, DatasetInfo* info) 
     where += " (\"" + name + "\")";
     if (!names.insert(name).second)
       reader.Fail(where + ".name", "expected unique camera names, \"" + name + "\" appears twice");
-    reader.OnlyKeys(entry, {"name", "width", "height", "K", "R", "t", "distortion"}, where);
+    reader.OnlyKeys(entry, {"name", "width", "height", "K", "R", "t", "distortion", "distortion_model"}, where);
     const int width = static_cast<int>(
         reader.Integer(reader.Required(entry, "width", where), where + ".width", 1, kMaxImageSide));
     const int height = static_cast<int>(
@@ -111,7 +111,12 @@ std::vector<Camera> ReadCamerasJson(const std::string& path, DatasetInfo* info) 
     Eigen::VectorXd distortion;
     if (const json* values = reader.Optional(entry, "distortion", where))
       distortion = Vector(reader, *values, -1, where + ".distortion");
-    cameras.emplace_back(name, width, height, K, R, t, distortion, path);
+    DistortionModel model = DistortionModel::kOpenCV;
+    if (const json* value = reader.Optional(entry, "distortion_model", where)) {
+      if (!value->is_string() || !ParseDistortionModel(value->get<std::string>(), &model))
+        reader.Fail(where + ".distortion_model", "expected \"opencv\" or \"fisheye\", got " + value->dump());
+    }
+    cameras.emplace_back(name, width, height, K, R, t, distortion, path, model);
   }
   if (info) *info = parsed;
   return cameras;
@@ -153,6 +158,8 @@ void WriteCamerasJson(const std::string& path, const std::vector<Camera>& camera
     entry["R"] = MatrixJson(camera.R());
     entry["t"] = VectorJson(camera.t());
     entry["distortion"] = VectorJson(camera.distortion());
+    if (camera.distortion_model() != DistortionModel::kOpenCV)
+      entry["distortion_model"] = DistortionModelName(camera.distortion_model());
     list.push_back(entry);
   }
   root["cameras"] = list;

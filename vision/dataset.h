@@ -62,9 +62,10 @@ struct DatasetInfo {
 
 // Parses and validates cameras.json (format "multiview-video/1"). Every camera needs
 // name (unique, non-empty, no '/'), width, height (positive integers), K (3×3), R (3×3
-// rotation), t (3-vector); "distortion" is optional with 0, 4 (k1 k2 p1 p2), 5 (k1 k2 p1
-// p2 k3) or 8 (OpenCV rational model k1 k2 p1 p2 k3 k4 k5 k6: accepted only when k4 = k5
-// = k6 = 0, since Camera models k1..k3 only; otherwise an error) values. Optional: fps
+// near-rotation, re-orthonormalized: vision/rotation.h), t (3-vector); "distortion" is
+// optional with 0, 4 (k1 k2 p1 p2), 5 (k1 k2 p1 p2 k3) or 8 (OpenCV's rational model k1 k2
+// p1 p2 k3 k4 k5 k6) values, or 4 (k1 k2 k3 k4) with "distortion_model": "fisheye"
+// (docs/dataset.md: extensions of the layout). Optional: fps
 // (> 0), frame_count (positive integer), units (string), bounds ({min: [3], max: [3]},
 // min < max). Unknown top-level or camera keys are errors.
 std::vector<Camera> ReadCamerasJson(const std::string& path, DatasetInfo* info = nullptr);

@@ -12,6 +12,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/error.h"
+#include "vision/import_media.h"
 
 namespace subflow::vision {
 namespace fs = std::filesystem;
@@ -64,9 +65,12 @@ void CheckPngHeader(const std::string& path, const Camera& camera) {
 
 // The per-camera folders <root>/<camera>/ of <frame><extension> files (images/, masks/):
 // returns each camera's frame indices; throws on unknown folders, stray files and
-// cameras without a folder or without frames.
+// cameras without a folder or without frames. With `extensions`, each camera's frames may
+// use any one image extension of vision/import_media.h (docs/dataset.md), found from its
+// first frame and returned per camera; without, `extension` is required.
 std::vector<std::set<int>> ScanFrameFolders(const fs::path& root, const std::vector<Camera>& cameras,
-                                            const std::string& extension) {
+                                            std::string extension,
+                                            std::vector<std::string>* extensions = nullptr) {
   std::set<std::string> names;
   for (const Camera& camera : cameras) names.insert(camera.name());
   for (const auto& entry : fs::directory_iterator(root)) {
@@ -83,6 +87,17 @@ std::vector<std::set<int>> ScanFrameFolders(const fs::path& root, const std::vec
       ThrowError(Str(folder), "", "missing: camera \"" + cameras[c].name() +
                                       "\" has no folder (expected " + Str(folder) + "/000000" +
                                       extension + ", ...)");
+    if (extensions) {
+      extension = ".png";
+      for (const auto& entry : fs::directory_iterator(folder)) {
+        const std::string found = entry.path().extension().string();
+        if (!Hidden(entry.path()) && IsImageExtension(found)) {
+          extension = found;
+          break;
+        }
+      }
+      extensions->push_back(extension);
+    }
     for (const auto& entry : fs::directory_iterator(folder)) {
       if (Hidden(entry.path())) continue;
       const int frame = FrameIndex(entry.path().filename().string(), extension);
@@ -121,7 +136,8 @@ void CheckFrames(const std::vector<std::set<int>>& frames, int frame_count, cons
 
 std::string DatasetLayout::ImagePath(int camera, int frame) const {
   if (videos) return video_paths[camera];
-  return Str(fs::path(directory) / "images" / cameras[camera].name() / (FrameName(frame) + ".png"));
+  const std::string extension = camera < static_cast<int>(image_extensions.size()) ? image_extensions[camera] : ".png";
+  return Str(fs::path(directory) / "images" / cameras[camera].name() / (FrameName(frame) + extension));
 }
 std::string DatasetLayout::MaskPath(int camera, int frame) const {
   return Str(fs::path(directory) / "masks" / cameras[camera].name() / (FrameName(frame) + ".png"));
@@ -153,7 +169,7 @@ cv::Mat ReadImageFile(const std::string& path, const Camera& camera) {
   if (!fs::is_regular_file(path)) ThrowError(path, "", "missing image file");
   cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty())
-    ThrowError(path, "", "unreadable image (cv::imread failed; expected an 8- or 16-bit PNG)");
+    ThrowError(path, "", "unreadable image (cv::imread failed; expected an 8- or 16-bit PNG or another image file)");
   if ((image.depth() != CV_8U && image.depth() != CV_16U) ||
       (image.channels() != 1 && image.channels() != 3 && image.channels() != 4))
     ThrowError(path, "pixel type",
@@ -181,13 +197,14 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
   if (fs::exists(images) && fs::exists(videos))
     ThrowError(directory, "images/ and videos/", "both present; expected exactly one source of frames");
   if (fs::is_directory(images)) {
-    const std::vector<std::set<int>> frames = ScanFrameFolders(images, cameras, ".png");
+    const std::vector<std::set<int>> frames = ScanFrameFolders(images, cameras, ".png", &layout.image_extensions);
     if (layout.info.frame_count) {
       layout.frame_count = *layout.info.frame_count;
     } else {
       for (const auto& set : frames) layout.frame_count = std::max(layout.frame_count, *set.rbegin() + 1);
     }
-    CheckFrames(frames, layout.frame_count, images, cameras, ".png", count_origin);
+    for (std::size_t c = 0; c < cameras.size(); ++c)
+      CheckFrames({frames[c]}, layout.frame_count, images, {cameras[c]}, layout.image_extensions[c], count_origin);
   } else if (fs::is_directory(videos)) {
     layout.videos = true;
     layout.video_paths.resize(cameras.size());
@@ -299,7 +316,7 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
   if (check_image_headers) {
     for (int c = 0; c < static_cast<int>(cameras.size()); ++c) {
       for (int f = 0; f < layout.frame_count; ++f) {
-        if (!layout.videos) CheckPngHeader(layout.ImagePath(c, f), cameras[c]);
+        if (!layout.videos && layout.image_extensions[c] == ".png") CheckPngHeader(layout.ImagePath(c, f), cameras[c]);
         if (layout.masks) CheckPngHeader(layout.MaskPath(c, f), cameras[c]);
       }
       if (layout.background) CheckPngHeader(layout.BackgroundPath(c), cameras[c]);

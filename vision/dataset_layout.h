@@ -20,6 +20,7 @@ struct DatasetLayout {
   int frame_count = 0;
   bool videos = false, masks = false, background = false, groundtruth = false;
   std::vector<std::string> video_paths;  // per camera, when `videos`
+  std::vector<std::string> image_extensions;  // per camera, when images/ (".png", ".jpg", ...)
 
   std::string ImagePath(int camera, int frame) const;  // the video's path when `videos`
   std::string MaskPath(int camera, int frame) const;

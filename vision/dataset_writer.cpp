@@ -11,7 +11,7 @@ namespace subflow::vision {
 namespace fs = std::filesystem;
 namespace {
 
-const char* const kDatasetEntries[] = {"cameras.json", "images", "videos", "masks", "background",
+const char* const kDatasetEntries[] = {"cameras.json", "report.json", "preview", "images", "videos", "masks", "background",
                                        "groundtruth"};
 
 void CreateDirectories(const fs::path& path) {
@@ -38,16 +38,14 @@ void WritePng(const fs::path& path, const cv::Mat& image) {
 
 }  // namespace
 
-DatasetWriter::DatasetWriter(const std::string& directory, std::vector<Camera> cameras,
-                             const DatasetInfo& info, bool overwrite)
-    : directory_(directory), cameras_(std::move(cameras)), info_(info) {
-  const fs::path root(directory_);
+void PrepareDatasetDirectory(const std::string& directory, bool overwrite) {
+  const fs::path root(directory);
   if (fs::exists(root)) {
     if (!fs::is_directory(root))
-      ThrowError(directory_, "", "exists and is not a directory (expected a new dataset directory)");
+      ThrowError(directory, "", "exists and is not a directory (expected a new dataset directory)");
     if (!fs::is_empty(root)) {
       if (!overwrite)
-        ThrowError(directory_, "", "exists and is not empty; refusing to overwrite it (choose another directory or pass "
+        ThrowError(directory, "", "exists and is not empty; refusing to overwrite it (choose another directory or pass "
                                    "--overwrite to replace the dataset in it)");
       for (const char* entry : kDatasetEntries) {
         std::error_code error;
@@ -57,6 +55,13 @@ DatasetWriter::DatasetWriter(const std::string& directory, std::vector<Camera> c
     }
   }
   CreateDirectories(root);
+}
+
+DatasetWriter::DatasetWriter(const std::string& directory, std::vector<Camera> cameras,
+                             const DatasetInfo& info, bool overwrite)
+    : directory_(directory), cameras_(std::move(cameras)), info_(info) {
+  PrepareDatasetDirectory(directory_, overwrite);
+  const fs::path root(directory_);
   WriteCamerasJson((root / "cameras.json").string(), cameras_, info_.fps, info_.frame_count,
                    info_.bounds, info_.units);
   for (const Camera& camera : cameras_) CreateDirectories(root / "images" / camera.name());

@@ -23,6 +23,13 @@ void WriteCamerasJson(const std::string& path, const std::vector<Camera>& camera
                       std::optional<double> fps, std::optional<int> frame_count,
                       const std::optional<Bounds>& bounds, const std::string& units = "");
 
+// Creates `directory` (and its parents) for a new dataset. Throws subflow::Error naming it
+// when it exists and is not an empty directory, unless `overwrite` is set: then only its
+// dataset entries (cameras.json, report.json, preview/, images/, videos/, masks/, background/,
+// groundtruth/) are
+// removed, nothing else.
+void PrepareDatasetDirectory(const std::string& directory, bool overwrite);
+
 // Creates a dataset directory and fills it. The constructor writes cameras.json and
 // creates images/<cam>/; the Write* calls write one file each (PNG, lossless). It never
 // overwrites a non-empty existing directory unless `overwrite` is set (then the

@@ -20,6 +20,21 @@
 // Overall: accuracy = percentile of the pooled samples of all frames; completeness,
 // chamfer = mean over frames; hausdorff = max; EPE mean / median / relative pooled over
 // all vertices of all frames.
+//
+// Observed surface (when the dataset's cameras are given): the part of T that at least
+// `min_views` cameras see (vision/evaluation_visibility.h, tolerance `visibility_tolerance`),
+// since nothing can be known about the rest. The same figures restricted to it:
+//   completeness, mean_truth_to_result   over the true samples t that are observed;
+//   accuracy, mean_result_to_truth       over the result samples r whose closest true
+//                                        point is observed (a bulge into a hollow counts);
+//   flow                                 over the result vertices whose closest true point
+//                                        is observed;
+//   observed_fraction                    of the true samples, observed;
+//   pixel_footprint                      mean over the observed true samples of their pixel
+//                                        footprint (world units per pixel), so that
+//   accuracy_px = accuracy / pixel_footprint.
+// Surfaces only (score_flow = false, e.g. visual hulls): result frames may change their
+// vertex count and faces; no flow is computed.
 #pragma once
 
 #include <functional>
@@ -30,6 +45,7 @@
 #include "geometry/closest_point.h"
 #include "core/progress.h"
 #include "geometry/triangle_mesh.h"
+#include "vision/camera.h"
 
 namespace subflow::vision {
 
@@ -37,6 +53,9 @@ struct EvaluationOptions {
   double threshold = 0.0;              // completeness distance; 0 = 1 % of the true bbox diagonal
   int samples = 50000;                 // area-weighted samples per surface and frame
   double accuracy_percentile = 90.0;   // in (0, 100]
+  int min_views = 2;                   // observed surface: seen by at least this many cameras
+  double visibility_tolerance = 0.0;   // depth tolerance of visibility; 0 = 0.25 % of the true bbox diagonal
+  bool score_flow = true;              // false: surfaces only, topology may change per frame
 
   void Check() const;  // throws subflow::Error naming the field
 };
@@ -54,10 +73,19 @@ struct FlowScores {
   double epe_normal_mean = 0.0, epe_tangential_mean = 0.0;
 };
 
+// The figures on the observed surface (see the file comment).
+struct ObservedScores {
+  bool evaluated = false;  // false without cameras
+  SurfaceScores surface;
+  FlowScores flow;
+  double observed_fraction = 0.0, pixel_footprint = 0.0, accuracy_px = 0.0;
+};
+
 struct FrameScores {
   int frame = -1;  // −1 for the overall figures
   SurfaceScores surface;
   FlowScores flow;
+  ObservedScores observed;
 };
 
 struct EvaluationReport {
@@ -66,7 +94,11 @@ struct EvaluationReport {
   double threshold = 0.0;
   int samples = 0;
   double accuracy_percentile = 90.0;
-  std::string flow_source;  // "vx vy vz" or "vertex differences"
+  std::string flow_source;  // "vx vy vz", "vertex differences" or "none"
+  std::string surfaces = "meshes";  // what was scored: the result's meshes/ or hull/
+  int camera_count = 0;     // cameras of the observed-surface figures (0 = not computed)
+  int min_views = 2;
+  double visibility_tolerance = 0.0;
 
   std::string Table() const;  // one line per frame + overall, fixed-width columns
   std::string Json() const;   // the same figures as a JSON document
@@ -92,15 +124,21 @@ EvaluationReport EvaluateSequence(int frame_count,
                                   const std::function<EvaluationFrame(int)>& load_result,
                                   const EvaluationOptions& options, Progress* progress = nullptr,
                                   const std::string& truth_source = "ground truth",
-                                  const std::string& result_source = "result");
+                                  const std::string& result_source = "result",
+                                  const std::vector<Camera>& cameras = {});
 
-// Reads DATASET/groundtruth/mesh/*.ply and RESULT/meshes/*.ply and evaluates them.
-// Throws subflow::Error for a missing directory, a gap in the frame numbers, different
-// frame counts, or meshes whose vertex count / faces change between frames.
+// Reads DATASET/groundtruth/mesh/*.ply and RESULT/<surfaces>/*.ply and evaluates them,
+// with DATASET/cameras.json's cameras for the observed surface (not scored when the
+// dataset has no cameras.json). surfaces = "meshes" (a
+// reconstruction, ../shared/OUTPUT.md) or "hull" (`subflow hull`'s visual hulls: surfaces
+// only, options.score_flow is set false). Throws subflow::Error for a missing directory, a
+// gap in the frame numbers, different frame counts, or (when scoring flow) meshes whose
+// vertex count / faces change between frames.
 EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
                                         const std::string& result_directory,
                                         const EvaluationOptions& options,
-                                        Progress* progress = nullptr);
+                                        Progress* progress = nullptr,
+                                        const std::string& surfaces = "meshes");
 
 // Frame files "<dir>/000000.ply" … of a directory, checked to be contiguous from 0, or,
 // when `first_frame` is given, from the first frame present (returned there). Throws

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "geometry/mesh_io.h"
+#include "vision/dataset.h"
 #include "vision/evaluation.h"
 
 namespace subflow::vision {
@@ -21,26 +22,54 @@ std::string FrameFileName(int frame) {
   return name;
 }
 
+void SurfaceAndFlowJson(const SurfaceScores& surface, const FlowScores& flow, nlohmann::json* json) {
+  (*json)["accuracy"] = surface.accuracy;
+  (*json)["completeness"] = surface.completeness;
+  (*json)["chamfer"] = surface.chamfer;
+  (*json)["hausdorff"] = surface.hausdorff;
+  (*json)["mean_result_to_truth"] = surface.mean_result_to_truth;
+  (*json)["mean_truth_to_result"] = surface.mean_truth_to_result;
+  if (flow.evaluated) {
+    (*json)["flow"] = {{"epe_mean", flow.epe_mean},
+                       {"epe_median", flow.epe_median},
+                       {"true_motion_mean", flow.true_motion_mean},
+                       {"epe_relative", flow.epe_relative},
+                       {"epe_normal_mean", flow.epe_normal_mean},
+                       {"epe_tangential_mean", flow.epe_tangential_mean}};
+  } else {
+    (*json)["flow"] = nullptr;
+  }
+}
+
 nlohmann::json ScoresJson(const FrameScores& scores) {
   nlohmann::json json;
   if (scores.frame >= 0) json["frame"] = scores.frame;
-  json["accuracy"] = scores.surface.accuracy;
-  json["completeness"] = scores.surface.completeness;
-  json["chamfer"] = scores.surface.chamfer;
-  json["hausdorff"] = scores.surface.hausdorff;
-  json["mean_result_to_truth"] = scores.surface.mean_result_to_truth;
-  json["mean_truth_to_result"] = scores.surface.mean_truth_to_result;
-  if (scores.flow.evaluated) {
-    json["flow"] = {{"epe_mean", scores.flow.epe_mean},
-                    {"epe_median", scores.flow.epe_median},
-                    {"true_motion_mean", scores.flow.true_motion_mean},
-                    {"epe_relative", scores.flow.epe_relative},
-                    {"epe_normal_mean", scores.flow.epe_normal_mean},
-                    {"epe_tangential_mean", scores.flow.epe_tangential_mean}};
-  } else {
-    json["flow"] = nullptr;
+  SurfaceAndFlowJson(scores.surface, scores.flow, &json);
+  if (scores.observed.evaluated) {
+    nlohmann::json observed;
+    SurfaceAndFlowJson(scores.observed.surface, scores.observed.flow, &observed);
+    observed["observed_fraction"] = scores.observed.observed_fraction;
+    observed["pixel_footprint"] = scores.observed.pixel_footprint;
+    observed["accuracy_px"] = scores.observed.accuracy_px;
+    json["observed"] = observed;
   }
   return json;
+}
+
+std::string ObservedLine(const std::string& label, const FrameScores& s) {
+  const ObservedScores& o = s.observed;
+  char line[256];
+  std::snprintf(line, sizeof(line), "%-8s %11.4g %8.3f %8.4f %11.4g %11.4g %8.4f %11.4g", label.c_str(),
+                o.surface.accuracy, o.accuracy_px, o.surface.completeness, o.surface.chamfer, o.surface.hausdorff,
+                o.observed_fraction, o.pixel_footprint);
+  std::string text = line;
+  if (o.flow.evaluated) {
+    std::snprintf(line, sizeof(line), " %11.4g %11.4g %8.4f", o.flow.epe_mean, o.flow.true_motion_mean,
+                  o.flow.epe_relative);
+  } else {
+    std::snprintf(line, sizeof(line), " %11s %11s %8s", "-", "-", "-");
+  }
+  return text + line + "\n";
 }
 
 std::string ScoresLine(const std::string& label, const FrameScores& s) {
@@ -89,10 +118,19 @@ std::vector<std::string> ListFrameMeshes(const std::string& directory, int* firs
 
 EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
                                         const std::string& result_directory,
-                                        const EvaluationOptions& options, Progress* progress) {
-  options.Check();
+                                        const EvaluationOptions& given_options, Progress* progress,
+                                        const std::string& surfaces) {
+  given_options.Check();
+  if (surfaces != "meshes" && surfaces != "hull")
+    ThrowError("eval", "surfaces", "expected meshes or hull, got \"" + surfaces + "\"");
+  EvaluationOptions options = given_options;
+  if (surfaces == "hull") options.score_flow = false;
   const std::string truth_directory = (fs::path(dataset_directory) / "groundtruth" / "mesh").string();
-  const std::string result_meshes = (fs::path(result_directory) / "meshes").string();
+  const std::string result_meshes = (fs::path(result_directory) / surfaces).string();
+  // Without cameras.json (a folder of ground truth only) there is no observed surface.
+  const fs::path cameras_path = fs::path(dataset_directory) / "cameras.json";
+  const std::vector<Camera> cameras = fs::exists(cameras_path) ? ReadCamerasJson(cameras_path.string())
+                                                               : std::vector<Camera>();
   // A result may cover a contiguous part of the sequence (reconstruct --first-frame/--frames).
   int first = 0;
   const std::vector<std::string> all_truth_paths = ListFrameMeshes(truth_directory);
@@ -129,7 +167,8 @@ EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
     return frame;
   };
   EvaluationReport report = EvaluateSequence(static_cast<int>(truth_paths.size()), load_truth, load_result,
-                                             options, progress, truth_directory, result_meshes);
+                                             options, progress, truth_directory, result_meshes, cameras);
+  report.surfaces = surfaces;
   for (FrameScores& frame : report.frames) frame.frame += first;
   return report;
 }
@@ -147,7 +186,18 @@ std::string EvaluationReport::Table() const {
   std::snprintf(footer, sizeof(footer),
                 "completeness threshold %.4g; %d samples per surface and frame; flow from %s\n", threshold,
                 samples, flow_source.c_str());
-  return table + footer;
+  table += footer;
+  if (!overall.observed.evaluated) return table + "observed surface: not scored (no cameras)\n";
+  std::snprintf(header, sizeof(header),
+                "\nobserved surface: seen by >= %d of %d cameras (visibility tolerance %.4g)\n"
+                "%-8s %11s %8s %8s %11s %11s %8s %11s %11s %11s %8s\n",
+                min_views, camera_count, visibility_tolerance, "frame",
+                ("accuracy" + std::to_string(static_cast<int>(accuracy_percentile))).c_str(), "acc_px", "complete",
+                "chamfer", "hausdorff", "observed", "px_size", "epe_mean", "true_mean", "epe_rel");
+  table += header;
+  for (const FrameScores& frame : frames) table += ObservedLine(FrameFileName(frame.frame).substr(0, 6), frame);
+  table += ObservedLine("overall", overall);
+  return table;
 }
 
 std::string EvaluationReport::Json() const {
@@ -156,6 +206,10 @@ std::string EvaluationReport::Json() const {
   json["samples"] = samples;
   json["accuracy_percentile"] = accuracy_percentile;
   json["flow_source"] = flow_source;
+  json["surfaces"] = surfaces;
+  json["camera_count"] = camera_count;
+  json["min_views"] = min_views;
+  json["visibility_tolerance"] = visibility_tolerance;
   json["overall"] = ScoresJson(overall);
   json["frames"] = nlohmann::json::array();
   for (const FrameScores& frame : frames) json["frames"].push_back(ScoresJson(frame));

@@ -12,8 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
-#include "geometry/vertex_normals.h"
-#include "vision/dataset_writer.h"
+#include "vision/synthetic_canvas.h"
 #include "vision/zbuffer.h"
 
 namespace subflow::vision {
@@ -40,14 +39,6 @@ double EncodeSrgb(double linear) {
   return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
 }
 
-std::uint64_t MixSeed(std::uint64_t a, std::uint64_t b) {
-  std::uint64_t h = a * 0x9E3779B97F4A7C15ull + b + 0x632BE59BD9B4E019ull;
-  h ^= h >> 31;
-  h *= 0xBF58476D1CE4E5B9ull;
-  h ^= h >> 27;
-  return h;
-}
-
 }  // namespace
 
 void SyntheticRenderOptions::Check() const {
@@ -59,8 +50,21 @@ void SyntheticRenderOptions::Check() const {
     ThrowError("synth", "noise", "expected a finite σ ≥ 0 (grey levels)");
 }
 
+ProceduralAlbedoOptions SyntheticRenderOptions::EnvironmentAlbedo() {
+  ProceduralAlbedoOptions o;
+  o.cell_size = 0.03;
+  o.border_width = 0.003;
+  o.blotch_size = 0.012;
+  o.blotch_contrast = 0.35;
+  o.min_brightness = 0.1;
+  o.max_brightness = 0.7;
+  o.tint = 0.4;
+  o.seed = 7;
+  return o;
+}
+
 SyntheticRenderer::SyntheticRenderer(const SyntheticRenderOptions& options)
-    : options_(options), albedo_(options.albedo) {
+    : options_(options), albedo_(options.albedo), environment_albedo_(options.environment_albedo) {
   options_.Check();
   textured_background_ = options_.background == "texture";
 }
@@ -100,12 +104,20 @@ RenderedView SyntheticRenderer::Render(const Camera& camera, const geometry::Pos
                                        const geometry::Faces& F, const geometry::Positions& normals,
                                        const geometry::Positions& rest, bool colour,
                                        std::uint64_t noise_seed) const {
-  SUBFLOW_CHECK(normals.rows() == V.rows() && rest.rows() == V.rows(), "one normal and rest position per vertex");
+  return Render(camera, SceneView{V, F, normals, rest, static_cast<int>(F.rows())}, colour, noise_seed);
+}
+
+RenderedView SyntheticRenderer::Render(const Camera& camera, const SceneView& scene, bool colour,
+                                       std::uint64_t noise_seed) const {
+  const geometry::Positions& V = scene.V;
+  const geometry::Faces& F = scene.F;
+  SUBFLOW_CHECK(scene.normals.rows() == V.rows() && scene.rest.rows() == V.rows(),
+                "one normal and rest position per vertex");
   const int s = options_.supersample;
-  const Camera fine_camera = SupersampledCamera(camera, s);
+  SampleCanvas canvas(camera, s);
   ZBufferOptions zbuffer_options;
-  zbuffer_options.cull_back_faces = true;  // scenes are closed surfaces seen from outside
-  const ZBuffer zbuffer(fine_camera, V, F, zbuffer_options);
+  zbuffer_options.cull_back_faces = true;  // closed surfaces seen from outside, walls seen from inside
+  canvas.Render(V, F, zbuffer_options);
 
   const int width = camera.width(), height = camera.height();
   std::vector<Eigen::Vector3d> radiance(static_cast<std::size_t>(width) * height);
@@ -118,22 +130,14 @@ RenderedView SyntheticRenderer::Render(const Camera& camera, const geometry::Pos
       int covered = 0;
       for (int j = 0; j < s; ++j) {
         for (int i = 0; i < s; ++i) {
-          const int fx = s * x + i, fy = s * y + j;
-          const int f = zbuffer.Face(fx, fy);
-          if (f < 0) {
-            sum += BackgroundRadiance(camera, (fx + 0.5) / s - 0.5, (fy + 0.5) / s - 0.5);
+          const CanvasHit hit = canvas.Hit(x, y, i, j, V, F);
+          if (hit.face < 0) {
+            sum += BackgroundRadiance(camera, (s * x + i + 0.5) / s - 0.5, (s * y + j + 0.5) / s - 0.5);
             continue;
           }
-          ++covered;
-          const Eigen::Vector2f uv = zbuffer.Barycentric(fx, fy);
-          const double w1 = uv.x(), w2 = uv.y(), w0 = 1.0 - w1 - w2;
-          const int a = F(f, 0), b = F(f, 1), c = F(f, 2);
-          const Eigen::Vector3d material = (w0 * rest.row(a) + w1 * rest.row(b) + w2 * rest.row(c)).transpose();
-          const Eigen::Vector3d normal =
-              (w0 * normals.row(a) + w1 * normals.row(b) + w2 * normals.row(c)).transpose().normalized();
-          double irradiance = kAmbient;
-          for (const Light& light : kLights) irradiance += light.strength * std::max(0.0, normal.dot(light.direction));
-          sum += irradiance * albedo_(material);
+          const bool subject = hit.face < scene.subject_face_count;
+          covered += subject ? 1 : 0;
+          sum += SampleRadiance(scene, hit, subject);
         }
       }
       radiance[static_cast<std::size_t>(y) * width + x] = sum * inverse_samples;
@@ -144,8 +148,29 @@ RenderedView SyntheticRenderer::Render(const Camera& camera, const geometry::Pos
   return view;
 }
 
-cv::Mat SyntheticRenderer::RenderBackground(const Camera& camera, bool colour,
-                                            std::uint64_t noise_seed) const {
+Eigen::Vector3d SyntheticRenderer::SampleRadiance(const SceneView& scene, const CanvasHit& hit, bool subject) const {
+  const double w1 = hit.w1, w2 = hit.w2, w0 = 1.0 - w1 - w2;
+  const int a = scene.F(hit.face, 0), b = scene.F(hit.face, 1), c = scene.F(hit.face, 2);
+  const Eigen::Vector3d material =
+      (w0 * scene.rest.row(a) + w1 * scene.rest.row(b) + w2 * scene.rest.row(c)).transpose();
+  const Eigen::Vector3d normal =
+      (w0 * scene.normals.row(a) + w1 * scene.normals.row(b) + w2 * scene.normals.row(c)).transpose().normalized();
+  double key = kLights[0].strength * std::max(0.0, normal.dot(kLights[0].direction));
+  if (scene.shadows != nullptr && key > 0.0) {
+    const Eigen::Vector3d X = (w0 * scene.V.row(a) + w1 * scene.V.row(b) + w2 * scene.V.row(c)).transpose();
+    key *= scene.shadows->LightFraction(X);
+  }
+  double irradiance = kAmbient + key;
+  for (std::size_t l = 1; l < std::size(kLights); ++l)
+    irradiance += kLights[l].strength * std::max(0.0, normal.dot(kLights[l].direction));
+  return irradiance * (subject ? albedo_(material) : environment_albedo_(material));
+}
+
+Eigen::Vector3d KeyLightDirection() { return kLights[0].direction; }
+
+cv::Mat SyntheticRenderer::RenderBackground(const Camera& camera, bool colour, std::uint64_t noise_seed,
+                                            const SceneView* environment) const {
+  if (environment != nullptr && environment->F.rows() > 0) return Render(camera, *environment, colour, noise_seed).image;
   const int s = options_.supersample, width = camera.width(), height = camera.height();
   std::vector<Eigen::Vector3d> radiance(static_cast<std::size_t>(width) * height);
   for (int y = 0; y < height; ++y) {
@@ -158,96 +183,6 @@ cv::Mat SyntheticRenderer::RenderBackground(const Camera& camera, bool colour,
     }
   }
   return Encode(radiance, width, height, colour, noise_seed);
-}
-
-void SynthOptions::Check() const {
-  scene.Check();
-  rig.Check();
-  render.Check();
-  for (int c : colour_cameras)
-    if (c < 0 || c >= rig.camera_count)
-      ThrowError("synth", "color-cameras",
-                 "camera index " + std::to_string(c) + " out of range 0.." + std::to_string(rig.camera_count - 1));
-  if (colour_every < 0) ThrowError("synth", "color-every", "expected ≥ 0");
-  if (!(fps > 0.0) || !std::isfinite(fps)) ThrowError("synth", "fps", "expected > 0");
-  if (!(bounds_margin >= 0.0) || !std::isfinite(bounds_margin))
-    ThrowError("synth", "bounds_margin", "expected ≥ 0");
-}
-
-bool SynthOptions::IsColourCamera(int camera) const {
-  if (colour_every > 0) return camera % colour_every == 0;
-  return std::find(colour_cameras.begin(), colour_cameras.end(), camera) != colour_cameras.end();
-}
-
-SynthSummary WriteSyntheticDataset(const std::string& directory, const SynthOptions& options,
-                                   Progress* progress) {
-  const auto start = std::chrono::steady_clock::now();
-  options.Check();
-  SyntheticSceneOptions scene_options = options.scene;
-  const SyntheticScene scene = MakeSyntheticScene(scene_options);
-
-  SynthSummary summary;
-  summary.frame_count = scene.frame_count();
-  summary.vertex_count = static_cast<int>(scene.rest.rows());
-  summary.face_count = static_cast<int>(scene.F.rows());
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = -low;
-  for (const geometry::Positions& V : scene.frames) {
-    low = low.cwiseMin(V.colwise().minCoeff().transpose());
-    high = high.cwiseMax(V.colwise().maxCoeff().transpose());
-  }
-  const Eigen::Vector3d margin = options.bounds_margin * (high - low);
-  summary.bounds.min = low - margin;
-  summary.bounds.max = high + margin;
-
-  const std::vector<Camera> cameras = MakeCameraRig(options.rig, 0.5 * (low + high));
-  summary.camera_count = static_cast<int>(cameras.size());
-  DatasetInfo info;
-  info.fps = options.fps;
-  info.frame_count = scene.frame_count();
-  info.bounds = summary.bounds;
-  info.units = "meters";
-  const DatasetWriter writer(directory, cameras, info, options.overwrite);
-
-  SyntheticRenderOptions render_options = options.render;
-  render_options.albedo.seed = options.seed;
-  const SyntheticRenderer renderer(render_options);
-  const int camera_count = summary.camera_count, frame_count = summary.frame_count;
-
-  std::vector<geometry::Positions> normals(static_cast<std::size_t>(frame_count));
-  tbb::parallel_for(0, frame_count, [&](int f) {
-    normals[f] = geometry::VertexNormals(scene.frames[f], scene.F);
-    writer.WriteGroundTruthMesh(f, scene.Mesh(f));
-  });
-  tbb::parallel_for(0, camera_count, [&](int c) {
-    writer.WriteBackground(c, renderer.RenderBackground(cameras[c], options.IsColourCamera(c),
-                                                        MixSeed(options.seed, 1000003ull * (c + 1))));
-  });
-
-  const auto render_start = std::chrono::steady_clock::now();
-  const int task_count = camera_count * frame_count;
-  ProgressBegin(progress, "synth: rendering " + std::to_string(task_count) + " images",
-                static_cast<std::size_t>(task_count));
-  std::atomic<int> done{0};
-  std::mutex progress_mutex;
-  int reported = 0;
-  tbb::parallel_for(0, task_count, [&](int task) {
-    const int f = task / camera_count, c = task % camera_count;
-    const std::uint64_t noise_seed = MixSeed(options.seed, static_cast<std::uint64_t>(task) + 1);
-    const RenderedView view = renderer.Render(cameras[c], scene.frames[f], scene.F, normals[f], scene.rest,
-                                              options.IsColourCamera(c), noise_seed);
-    writer.WriteImage(c, f, view.image);
-    writer.WriteMask(c, f, view.mask);
-    const int finished = ++done;
-    std::lock_guard<std::mutex> lock(progress_mutex);
-    reported = std::max(reported, finished);
-    ProgressUpdate(progress, static_cast<std::size_t>(reported));
-  });
-  ProgressEnd(progress);
-  const auto end = std::chrono::steady_clock::now();
-  summary.render_seconds = std::chrono::duration<double>(end - render_start).count();
-  summary.seconds = std::chrono::duration<double>(end - start).count();
-  return summary;
 }
 
 }  // namespace subflow::vision

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "geometry/icosphere.h"
+#include "vision/synthetic_subject.h"
 
 namespace subflow::vision {
 namespace {
@@ -39,7 +40,7 @@ SyntheticScene MakeBlob(const geometry::TriangleMesh& sphere, const SyntheticSce
                          {40.0 * Eigen::Vector3d(0.1, -0.5, 0.86).normalized(), 0.003, 0.3, 2.6}};
   const Eigen::Vector3d velocity = 0.00127 * Eigen::Vector3d(1.0, -0.6, 0.5).normalized();
   for (int f = 0; f < o.frame_count; ++f) {
-    const double tau = o.motion * f;
+    const double tau = o.motion * (o.start_frame + f);
     Positions V(scene.rest.rows(), 3);
     for (Eigen::Index i = 0; i < V.rows(); ++i) {
       const Eigen::Vector3d x = scene.rest.row(i);
@@ -66,7 +67,7 @@ SyntheticScene MakeRigid(const geometry::TriangleMesh& sphere, const SyntheticSc
   const Eigen::Vector3d axis = Eigen::Vector3d(0.3, 0.2, 1.0).normalized();
   const Eigen::Vector3d velocity = 0.0015 * Eigen::Vector3d(-0.5, 1.0, 0.3).normalized();
   for (int f = 0; f < o.frame_count; ++f) {
-    const double tau = o.motion * f;
+    const double tau = o.motion * (o.start_frame + f);
     const Eigen::Matrix3d R = Eigen::AngleAxisd(2.0 * kDegree * tau, axis).toRotationMatrix();
     Positions V(scene.rest.rows(), 3);
     for (Eigen::Index i = 0; i < V.rows(); ++i) {
@@ -94,7 +95,7 @@ SyntheticScene MakeHead(const geometry::TriangleMesh& sphere, const SyntheticSce
   // Jaw: front (y < −0.02) and below the mouth line (z < −0.025), blended over 2 cm.
   const Eigen::Vector3d hinge(0.0, 0.01, -0.01);
   for (int f = 0; f < o.frame_count; ++f) {
-    const double tau = o.motion * f;
+    const double tau = o.motion * (o.start_frame + f);
     const Eigen::Matrix3d jaw = Eigen::AngleAxisd(0.8 * kDegree * tau, Eigen::Vector3d::UnitX()).toRotationMatrix();
     const Eigen::Matrix3d yaw = Eigen::AngleAxisd(1.2 * kDegree * tau, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     Positions V(scene.rest.rows(), 3);
@@ -114,7 +115,7 @@ SyntheticScene MakeSphere(const geometry::TriangleMesh& sphere, const SyntheticS
   const Eigen::Vector3d axis = Eigen::Vector3d(-0.2, 0.4, 1.0).normalized();
   const Eigen::Vector3d velocity = 0.0015 * Eigen::Vector3d(1.0, 0.5, -0.4).normalized();
   for (int f = 0; f < o.frame_count; ++f) {
-    const double tau = o.motion * f;
+    const double tau = o.motion * (o.start_frame + f);
     const Eigen::Matrix3d R = Eigen::AngleAxisd(2.0 * kDegree * tau, axis).toRotationMatrix();
     Positions V = scene.rest * R.transpose();
     V.rowwise() += (tau * velocity).transpose();
@@ -128,7 +129,14 @@ SyntheticScene MakeSphere(const geometry::TriangleMesh& sphere, const SyntheticS
 void SyntheticSceneOptions::Check() const {
   const auto names = SyntheticSceneNames();
   if (std::find(names.begin(), names.end(), scene) == names.end())
-    ThrowError("synthetic scene", "scene", "expected blob, rigid, head or sphere, got \"" + scene + "\"");
+    ThrowError("synthetic scene", "scene",
+               "expected blob, rigid, head, sphere, bust, mug, pair or critter, got \"" + scene + "\"");
+  if (start_frame < 0) ThrowError("synthetic scene", "start-frame", "expected ≥ 0");
+  if (IsSdfSubject(scene)) {
+    SdfMeshOptions mesh_options;
+    mesh_options.voxel_size = voxel_size;
+    mesh_options.Check();
+  }
   if (frame_count < 1) ThrowError("synthetic scene", "frames", "expected at least 1 frame");
   if (!std::isfinite(motion) || motion < 0.0)
     ThrowError("synthetic scene", "motion", "expected a finite non-negative scale");
@@ -136,10 +144,24 @@ void SyntheticSceneOptions::Check() const {
     ThrowError("synthetic scene", "subdivisions", "expected 1..7, got " + std::to_string(subdivisions));
 }
 
-std::vector<std::string> SyntheticSceneNames() { return {"blob", "rigid", "head", "sphere"}; }
+std::vector<std::string> SyntheticSceneNames() {
+  std::vector<std::string> names = {"blob", "rigid", "head", "sphere"};
+  for (const std::string& name : SdfSubjectNames()) names.push_back(name);
+  return names;
+}
 
-SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
+SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options, Progress* progress) {
   options.Check();
+  if (IsSdfSubject(options.scene)) {
+    const SdfSubject subject = MakeSdfSubject(options.scene);
+    SdfMeshOptions mesh_options;
+    mesh_options.voxel_size = options.voxel_size;
+    const geometry::TriangleMesh rest = MeshSdfSubject(subject, mesh_options, progress);
+    SyntheticScene scene{options.scene, rest.F, rest.V, {}};
+    for (int f = 0; f < options.frame_count; ++f)
+      scene.frames.push_back(subject.deformation.Apply(rest.V, options.motion * (options.start_frame + f)));
+    return scene;
+  }
   const geometry::TriangleMesh sphere = geometry::MakeIcosphere(options.subdivisions, 1.0);
   if (options.scene == "blob") return MakeBlob(sphere, options);
   if (options.scene == "rigid") return MakeRigid(sphere, options);

@@ -24,20 +24,28 @@
 //          analytically (the pixels whose ray passes within r of the centre, which is
 //          the mean of the vertices), which checks the renderer and the camera
 //          convention independently of the z-buffer; and it is convex.
+//   bust, mug, pair, critter   signed-distance subjects with thin parts, hollows, a
+//          handle, two bodies, articulations (vision/synthetic_subject.h), meshed at
+//          `voxel_size` (not `subdivisions`).
+// Frame f is rendered at τ = motion · (start_frame + f): a still (frame_count 1) of any
+// moment of a scene is start_frame = that moment.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "geometry/triangle_mesh.h"
 
 namespace subflow::vision {
 
 struct SyntheticSceneOptions {
-  std::string scene = "blob";  // "blob", "rigid", "head" or "sphere"
+  std::string scene = "blob";  // SyntheticSceneNames()
   int frame_count = 24;        // frames 0..frame_count−1
+  int start_frame = 0;         // frame f shows the scene at its frame start_frame + f
   double motion = 1.0;         // scales the motion per frame (0 = static)
   int subdivisions = 5;        // icosphere levels: 5 → 10242 vertices, 20480 triangles
+  double voxel_size = 0.0015;  // SDF subjects: meshing voxel (m); ≤ 1.5 mm resolves 3 mm plates
 
   // Throws subflow::Error naming the field when a value is out of range.
   void Check() const;
@@ -56,6 +64,6 @@ struct SyntheticScene {
 // The scene names MakeSyntheticScene accepts.
 std::vector<std::string> SyntheticSceneNames();
 
-SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options);
+SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options, Progress* progress = nullptr);
 
 }  // namespace subflow::vision

@@ -95,10 +95,21 @@ const std::map<std::string, const WritingCommand*>& Commands() {
   static const WritingCommand reconstruct{
       true, [](const fs::path& out) { return "reconstruct " + Quoted(TinyDataset()) + " --out " + Quoted(out) + HullOptions(); },
       false};
+  static const WritingCommand export_glb{
+      false, [](const fs::path& out) { return "export " + Quoted(TinyResult()) + " --format glb --out " + Quoted(out); },
+      true};
+  static const WritingCommand import_qualisys{
+      true,
+      [](const fs::path& out) {
+        const fs::path take = fs::path(SUBFLOW_SHARED_DIR) / "data" / "pose2sim_multiperson";
+        return "import qualisys " + Quoted(take / "calibration" / "Calib.qca.txt") + " --videos " +
+               Quoted(take / "videos") + " --out " + Quoted(out);
+      },
+      true};
   static const std::map<std::string, const WritingCommand*> commands = {
       {"check", nullptr},  // prints its figures (text or --json) on stdout only
       {"subdivide", &subdivide}, {"eval", &eval}, {"synth", &synth}, {"hull", &hull},
-      {"reconstruct", &reconstruct}};
+      {"reconstruct", &reconstruct}, {"export", &export_glb}, {"import", &import_qualisys}};
   return commands;
 }
 

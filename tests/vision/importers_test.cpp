@@ -12,9 +12,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
-#include "vision/colmap_import.h"
-#include "vision/projection_matrix_import.h"
+#include "vision/import_colmap.h"
+#include "vision/import_projection_matrices.h"
 #include "tests/test_support.h"
+#include "tests/vision/import_test_support.h"
 
 namespace subflow::vision {
 namespace {
@@ -26,15 +27,7 @@ const test::TemporaryDirectory& Scratch() {
   return scratch;
 }
 
-template <typename Action>
-std::string ErrorOf(Action action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "no error";
-}
+using test::ErrorOf;
 
 #define EXPECT_CONTAINS(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
 

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "vision/calibration_import.h"
 #include "vision/camera.h"
 
 namespace subflow::vision {
@@ -37,10 +38,21 @@ std::vector<Camera> ReadProjectionMatrixFolder(const std::string& directory,
 
 // A Middlebury multi-view "*_par.txt": first line the camera count n, then n lines
 // "imgname k11 k12 k13 k21 k22 k23 k31 k32 k33 r11 r12 r13 r21 r22 r23 r31 r32 r33 t1 t2 t3"
-// (P = K [R | t] given as K, R, t; as the files print R to limited precision, an R within
-// 1e-4 of a rotation is projected to the nearest one, any other R is an error). Camera
+// (P = K [R | t] given as K, R, t; as the files print R to limited precision, Camera takes
+// the nearest rotation, vision/rotation.h). Camera
 // name = stem of imgname. Throws naming the file and line.
 std::vector<Camera> ReadMiddleburyParameters(const std::string& par_file,
                                              const ProjectionMatrixImportOptions& options = {});
+
+// The same as Calibrations for `subflow import` (formats "matrices" and "middlebury"):
+// sizes found as above, or left 0 (taken from the media) unless `require_sizes`.
+Calibration ReadProjectionMatrixCalibration(const std::string& directory,
+                                            const ProjectionMatrixImportOptions& options = {},
+                                            bool require_sizes = false);
+Calibration ReadMiddleburyCalibration(const std::string& par_file, const ProjectionMatrixImportOptions& options = {},
+                                      bool require_sizes = false);
+// K, R, t of P = λ K [R | t] (see CameraFromProjectionMatrix), size unknown.
+CalibratedCamera DecomposeProjectionMatrix(const Eigen::Matrix<double, 3, 4>& P, const std::string& name,
+                                           const std::string& source);
 
 }  // namespace subflow::vision

@@ -1,4 +1,4 @@
-#include "vision/projection_matrix_import.h"
+#include "vision/import_projection_matrices.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,8 +15,6 @@
 namespace subflow::vision {
 namespace fs = std::filesystem;
 namespace {
-
-constexpr double kMiddleburyRotationTolerance = 1e-4;
 
 std::string LineField(int line) { return "line " + std::to_string(line); }
 
@@ -36,8 +34,10 @@ bool ImageSize(const fs::path& path, int* width, int* height) {
   return true;
 }
 
+// Leaves the size 0 when it is unknown and `required` is false.
 void SizeFor(const std::string& name, const fs::path& folder, const ProjectionMatrixImportOptions& options,
-             const std::string& source, int* width, int* height, const std::string& image_file = "") {
+             const std::string& source, int* width, int* height, const std::string& image_file = "",
+             bool required = true) {
   if (options.width > 0 && options.height > 0) {
     *width = options.width;
     *height = options.height;
@@ -45,12 +45,13 @@ void SizeFor(const std::string& name, const fs::path& folder, const ProjectionMa
   }
   const fs::path directory = options.image_directory.empty() ? folder : fs::path(options.image_directory);
   if (!image_file.empty()) {
-    if (ImageSize(directory / image_file, width, height)) return;
+    if (ImageSize(directory / image_file, width, height) || !required) return;
     ThrowError(source, "image size",
                "unknown: cannot read " + (directory / image_file).string() + " (give width and height)");
   }
   for (const char* extension : {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm"})
     if (ImageSize(directory / (name + extension), width, height)) return;
+  if (!required) return;
   ThrowError(source, "image size",
              "unknown: no readable image " + name + ".<png|jpg|...> in " + directory.string() +
                  " (give width and height)");
@@ -58,8 +59,8 @@ void SizeFor(const std::string& name, const fs::path& folder, const ProjectionMa
 
 }  // namespace
 
-Camera CameraFromProjectionMatrix(const Eigen::Matrix<double, 3, 4>& P, std::string name, int width,
-                                  int height, const std::string& source) {
+CalibratedCamera DecomposeProjectionMatrix(const Eigen::Matrix<double, 3, 4>& P, const std::string& name,
+                                           const std::string& source) {
   const std::string field = "camera \"" + name + "\": P";
   if (!P.allFinite()) ThrowError(source, field, "expected finite values");
   const Eigen::Matrix3d M = P.leftCols<3>();
@@ -88,12 +89,23 @@ Camera CameraFromProjectionMatrix(const Eigen::Matrix<double, 3, 4>& P, std::str
   }
   K(1, 0) = K(2, 0) = K(2, 1) = 0;
   K(2, 2) = 1;
-  const Eigen::Vector3d t = K.inverse() * P.col(3) / lambda;
-  return Camera(std::move(name), width, height, K, R, t, Eigen::VectorXd(), source);
+  CalibratedCamera camera;
+  camera.name = name;
+  camera.K = K;
+  camera.R = R;
+  camera.t = K.inverse() * P.col(3) / lambda;
+  camera.source = source;
+  return camera;
 }
 
-std::vector<Camera> ReadProjectionMatrixFolder(const std::string& directory,
-                                               const ProjectionMatrixImportOptions& options) {
+Camera CameraFromProjectionMatrix(const Eigen::Matrix<double, 3, 4>& P, std::string name, int width,
+                                  int height, const std::string& source) {
+  const CalibratedCamera c = DecomposeProjectionMatrix(P, name, source);
+  return Camera(std::move(name), width, height, c.K, c.R, c.t, Eigen::VectorXd(), source);
+}
+
+Calibration ReadProjectionMatrixCalibration(const std::string& directory,
+                                            const ProjectionMatrixImportOptions& options, bool require_sizes) {
   if (!fs::is_directory(directory))
     ThrowError(directory, "", "not a directory (expected a folder of 3×4 projection-matrix files)");
   std::vector<fs::path> files;
@@ -102,7 +114,8 @@ std::vector<Camera> ReadProjectionMatrixFolder(const std::string& directory,
   std::sort(files.begin(), files.end());
   if (files.empty())
     ThrowError(directory, "", "no *" + options.extension + " projection-matrix files");
-  std::vector<Camera> cameras;
+  Calibration calibration;
+  calibration.format = "matrices";
   for (const fs::path& file_path : files) {
     const std::string path = file_path.string();
     std::ifstream file(path);
@@ -138,19 +151,32 @@ std::vector<Camera> ReadProjectionMatrixFolder(const std::string& directory,
       ThrowError(path, LineField(line), "expected 3 rows of 4 numbers, got " + std::to_string(row) + " rows");
     const std::string name = file_path.stem().string();
     int width = 0, height = 0;
-    SizeFor(name, file_path.parent_path(), options, path, &width, &height);
-    cameras.push_back(CameraFromProjectionMatrix(P, name, width, height, path));
+    SizeFor(name, file_path.parent_path(), options, path, &width, &height, "", require_sizes);
+    CalibratedCamera camera = DecomposeProjectionMatrix(P, name, path);
+    camera.width = width;
+    camera.height = height;
+    calibration.cameras.push_back(camera);
   }
-  return cameras;
+  calibration.notes.push_back("3×4 projection matrices decomposed (RQ) into K [R | t]; pixel centres at integers; "
+                              "no distortion, no metric scale");
+  CheckCameraNames(calibration, directory);
+  return calibration;
 }
 
-std::vector<Camera> ReadMiddleburyParameters(const std::string& par_file,
-                                             const ProjectionMatrixImportOptions& options) {
+std::vector<Camera> ReadProjectionMatrixFolder(const std::string& directory,
+                                               const ProjectionMatrixImportOptions& options) {
+  return ToCameras(ReadProjectionMatrixCalibration(directory, options, true));
+}
+
+Calibration ReadMiddleburyCalibration(const std::string& par_file, const ProjectionMatrixImportOptions& options,
+                                      bool require_sizes) {
   std::ifstream file(par_file);
   if (!file) ThrowError(par_file, "", "cannot open (expected a Middlebury *_par.txt file)");
   std::string text;
   int line = 0, count = -1;
-  std::vector<Camera> cameras;
+  Calibration calibration;
+  calibration.format = "middlebury";
+  std::vector<CalibratedCamera>& cameras = calibration.cameras;
   while (std::getline(file, text)) {
     ++line;
     text = Trim(text);
@@ -180,22 +206,33 @@ std::vector<Camera> ReadMiddleburyParameters(const std::string& par_file,
     R << v[9], v[10], v[11], v[12], v[13], v[14], v[15], v[16], v[17];
     const Eigen::Vector3d t(v[18], v[19], v[20]);
     const std::string source = par_file + ": " + LineField(line);
-    // The files print R to limited precision: project to the nearest rotation when close.
-    if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < kMiddleburyRotationTolerance &&
-        std::abs(R.determinant() - 1) < kMiddleburyRotationTolerance) {
-      Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      R = svd.matrixU() * svd.matrixV().transpose();
-    }
+    // The files print R to limited precision: Camera takes the nearest rotation.
     const std::string name = fs::path(image_name).stem().string();
     int width = 0, height = 0;
-    SizeFor(name, fs::path(par_file).parent_path(), options, source, &width, &height, image_name);
-    cameras.emplace_back(name, width, height, K, R, t, Eigen::VectorXd(), source);
+    SizeFor(name, fs::path(par_file).parent_path(), options, source, &width, &height, image_name, require_sizes);
+    CalibratedCamera camera;
+    camera.name = name;
+    camera.width = width;
+    camera.height = height;
+    camera.K = K;
+    camera.R = R;
+    camera.t = t;
+    camera.image_name = image_name;
+    camera.source = source;
+    cameras.push_back(camera);
   }
   if (count < 0) ThrowError(par_file, "", "empty (expected the number of cameras on the first line)");
   if (static_cast<int>(cameras.size()) != count)
     ThrowError(par_file, LineField(line), "expected " + std::to_string(count) + " camera lines, got " +
                                               std::to_string(cameras.size()));
-  return cameras;
+  calibration.notes.push_back("Middlebury *_par.txt: K, R, t as given (P = K [R | t]); no distortion, no metric scale");
+  CheckCameraNames(calibration, par_file);
+  return calibration;
+}
+
+std::vector<Camera> ReadMiddleburyParameters(const std::string& par_file,
+                                             const ProjectionMatrixImportOptions& options) {
+  return ToCameras(ReadMiddleburyCalibration(par_file, options, true));
 }
 
 }  // namespace subflow::vision

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Regenerates the synthetic scenes of the fidelity baseline (issue 12) and the synthetic
+# takes with real-capture difficulties (issue 13 item 5).
+#   scripts/make_scenes.sh [OUT_DIR=/work/scenes] [SUBFLOW=build/cli/subflow] [SCENE...]
+# Each scene is a dataset in the DATASET.md layout with ground truth; existing ones are
+# replaced (--overwrite). Sizes are the moderate ones of the baseline (320×240, 24 frames):
+# reconstructing one takes minutes. The `take_hd` scene is 1088×1920 and slow.
+set -euo pipefail
+OUT=${1:-/work/scenes}
+SUBFLOW=${2:-build/cli/subflow}
+shift $(( $# > 2 ? 2 : $# )) || true
+ONLY=("$@")
+mkdir -p "$OUT"
+
+scene() {  # scene NAME ARGS...
+  local name=$1; shift
+  if [ ${#ONLY[@]} -gt 0 ] && [[ ! " ${ONLY[*]} " == *" $name "* ]]; then return; fi
+  echo "== $name: subflow synth $*"
+  "$SUBFLOW" synth "$@" --out "$OUT/$name" --overwrite | grep -v '^\s*$' | tail -3
+}
+
+# Head-like bust (3 mm ear plates, eye sockets, mouth, jaw opening), 11 cameras in front only,
+# a textured room behind, soft shadows; masks and a background image.
+scene bust_front   bust    --rig front --cameras 11 --environment room --shadows --frames 24
+# Genus-1 mug that tumbles and bends, ring of 10, textured floor, shadows.
+scene mug_ring     mug     --rig ring --cameras 10 --environment floor --shadows --frames 24
+# Two figures moving independently, dome of 10, textured room.
+scene pair_dome    pair    --rig dome --cameras 10 --environment room --frames 24
+# Twisting animal-like critter, ring of 10, textured room and shadows; with masks (for the
+# exact-mask hull) and the same images without masks (reconstructed from the background image).
+scene critter_ring critter --rig ring --cameras 10 --environment room --shadows --frames 24
+scene critter_nomasks critter --rig ring --cameras 10 --environment room --shadows --frames 24 --no-masks
+# Stills (one frame) of the bust's frame 30: with masks, and without masks or background.
+scene bust_still   bust    --rig front --cameras 11 --environment room --shadows --frames 1 --start-frame 30
+scene bust_still_bare bust --rig front --cameras 11 --environment room --shadows --frames 1 --start-frame 30 \
+  --no-masks --no-background
+# A take like a real capture: 4 cameras, HD portrait, lens distortion, a walker outside the
+# working volume and a ball crossing in front of cam00, MP4 videos, no masks, no background.
+scene take_hd      pair    --rig ring --cameras 4 --width 1088 --height 1920 --supersample 2 \
+  --distortion -0.12,0.03,0,0,0 --environment room --distractors both --video mp4 --no-masks \
+  --no-background --frames 10
