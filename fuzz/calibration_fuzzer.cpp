@@ -18,8 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(root, error))
     if (entry.is_regular_file(error)) sources.push_back(entry.path().string());
-  for (const auto& [format, description] : subflow::vision::CalibrationFormats())
+  for (const auto& format : subflow::vision::CalibrationFormats())  // {name, description}
     for (const std::string& source : sources)
-      subflow::fuzz::RunReader([&] { subflow::vision::ReadCalibration(format, source); });
+      subflow::fuzz::RunReader([&] { subflow::vision::ReadCalibration(format.first, source); });
   return 0;
 }
