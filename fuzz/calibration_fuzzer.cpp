@@ -5,15 +5,11 @@
 #include "fuzz/fuzz_support.h"
 #include "vision/read_calibration.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  subflow::fuzz::QuietLogs();
-  return 0;
-}
+SUBFLOW_FUZZ_QUIET_INITIALIZE()
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace fs = std::filesystem;
-  const auto root = subflow::fuzz::FreshScratch();
-  subflow::fuzz::WriteFileTree(data, size, root);
+  const auto root = subflow::fuzz::TreeOfInput(data, size);
   std::vector<std::string> sources{root.string()};
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(root, error))

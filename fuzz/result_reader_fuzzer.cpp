@@ -4,14 +4,10 @@
 #include "fuzz/fuzz_support.h"
 #include "output/result_reader.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  subflow::fuzz::QuietLogs();
-  return 0;
-}
+SUBFLOW_FUZZ_QUIET_INITIALIZE()
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const auto root = subflow::fuzz::FreshScratch();
-  subflow::fuzz::WriteFileTree(data, size, root);
+  const auto root = subflow::fuzz::TreeOfInput(data, size);
   subflow::fuzz::RunReader([&] { subflow::output::CheckResultFolder(root.string()); });
   return 0;
 }
