@@ -6,10 +6,13 @@
 #include <memory>
 #include <string>
 
+#include <spdlog/spdlog.h>
+
 #include "cli/commands.h"
 #include "core/error.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/mesh_io.h"
+#include "geometry/unused_vertices.h"
 #include "output/overwrite_guard.h"
 
 namespace subflow::cli {
@@ -26,7 +29,10 @@ struct SubdivideSettings {
 void RunSubdivide(const SubdivideSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
   output::CheckOutputFile(settings.output_path, settings.overwrite, "--out");
-  const geometry::TriangleMesh base = geometry::ReadMesh(settings.input_path);
+  geometry::TriangleMesh base = geometry::ReadMesh(settings.input_path);
+  if (const int unused = geometry::RemoveUnusedVertices(&base))
+    spdlog::warn("{}: {} vertices referenced by no face are left out; the others keep their order",
+                 settings.input_path, unused);
   const geometry::LoopHierarchy hierarchy(base.F, base.vertex_count(), settings.levels,
                                           settings.input_path);
   geometry::TriangleMesh result;
@@ -70,8 +76,9 @@ Command AddSubdivideCommand(CLI::App& app) {
       ->required();
   command->add_flag("--overwrite", settings->overwrite, "Replace the output mesh if it exists");
   command->footer(
-      "Vertex order: the input vertices keep their indices; each level appends one vertex "
-      "per edge of the previous level.\nExample: subflow subdivide base.ply --levels 3 "
+      "Vertex order: the input vertices keep their order (vertices no face uses are left out, with a "
+      "warning); each level appends one vertex per edge of the previous level. Polygon faces are "
+      "triangulated on reading, with a warning.\nExample: subflow subdivide base.ply --levels 3 "
       "--limit --out smooth.ply");
   return {command, [settings] { RunSubdivide(*settings); }};
 }

@@ -2,10 +2,7 @@
 #include "fuzz/fuzz_support.h"
 #include "vision/dataset.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  subflow::fuzz::QuietLogs();
-  return 0;
-}
+SUBFLOW_FUZZ_QUIET_INITIALIZE()
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto path = subflow::fuzz::FreshScratch() / "cameras.json";

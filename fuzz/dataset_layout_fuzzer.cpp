@@ -4,14 +4,10 @@
 #include "fuzz/fuzz_support.h"
 #include "vision/dataset.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  subflow::fuzz::QuietLogs();
-  return 0;
-}
+SUBFLOW_FUZZ_QUIET_INITIALIZE()
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const auto root = subflow::fuzz::FreshScratch();
-  subflow::fuzz::WriteFileTree(data, size, root);
+  const auto root = subflow::fuzz::TreeOfInput(data, size);
   subflow::fuzz::RunReader([&] {
     const subflow::vision::Dataset dataset(root.string());
     for (int c = 0; c < dataset.camera_count(); ++c) {

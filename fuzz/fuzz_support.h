@@ -130,4 +130,18 @@ inline void WriteFileTree(const std::uint8_t* data, std::size_t size, const fs::
   }
 }
 
+// A fresh scratch directory holding the file tree of the fuzzer's input.
+inline fs::path TreeOfInput(const std::uint8_t* data, std::size_t size) {
+  const fs::path root = FreshScratch();
+  WriteFileTree(data, size, root);
+  return root;
+}
+
 }  // namespace subflow::fuzz
+
+// Every harness's LLVMFuzzerInitialize: the readers' warnings silenced.
+#define SUBFLOW_FUZZ_QUIET_INITIALIZE()                  \
+  extern "C" int LLVMFuzzerInitialize(int*, char***) { \
+    subflow::fuzz::QuietLogs();                        \
+    return 0;                                          \
+  }

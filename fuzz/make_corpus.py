@@ -146,6 +146,22 @@ def main():
         ("scene_par.txt", "2\nimg0.png 50 0 32 0 50 24 0 0 1 1 0 0 0 1 0 0 0 1 0 0 2\n"
                           "img1.png 50 0 32 0 50 24 0 0 1 0 0 -1 0 1 0 1 0 0 0 0 2\n"),
         ("img0.png", png(8, 6)), ("img1.png", png(8, 6))]))
+    # Every calibration importer (calibration_fuzzer): the COLMAP and matrix seeds, a
+    # Pose2Sim TOML and a Panoptic JSON.
+    write("calibration_fuzzer", "colmap", tree([("cameras.txt", cameras_txt), ("images.txt", images_txt)]))
+    write("calibration_fuzzer", "dtu_folder", tree([("pos_001.txt", P), ("pos_001.png", png(8, 6))]))
+    write("calibration_fuzzer", "pose2sim_toml", tree([("Calib.toml",
+        '[cam_01]\nname = "cam_01"\nsize = [ 64.0, 48.0]\nmatrix = [ [ 50.0, 0.0, 32.0], [ 0.0, 50.0, 24.0], [ 0.0, 0.0, 1.0]]\n'
+        'distortions = [ 0.01, 0.0, 0.0, 0.0]\nrotation = [ 0.1, 0.2, 0.3]\ntranslation = [ 0.0, 0.0, 2.0]\nfisheye = false\n\n'
+        '[metadata]\nadjusted = false\nerror = 0.0\n')]))
+    write("calibration_fuzzer", "panoptic_json", tree([("calibration.json", json.dumps({"cameras": [
+        {"name": "00_00", "type": "hd", "resolution": [64, 48], "K": [[50, 0, 32], [0, 50, 24], [0, 0, 1]],
+         "distCoef": [0.01, 0, 0, 0, 0], "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "t": [[0], [0], [200]]}]}))]))
+    # A result folder (result_reader_fuzzer): two frames with flow, and a report.
+    flow = ply_ascii(TETRA_V, TETRA_F).replace("property float z\n", "property float z\nproperty float vx\nproperty float vy\nproperty float vz\n")
+    flow = flow.replace("0 0 0\n1 0 0\n0 1 0\n0 0 1\n", "0 0 0 0.1 0 0\n1 0 0 0.1 0 0\n0 1 0 0.1 0 0\n0 0 1 0.1 0 0\n")
+    write("result_reader_fuzzer", "two_frames", tree([("meshes/000000.ply", flow), ("meshes/000001.ply", flow),
+                                                      ("report.json", json.dumps({"command": "reconstruct", "fps": 30, "units": "meters"}))]))
     return 0
 
 

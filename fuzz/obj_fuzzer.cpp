@@ -4,10 +4,7 @@
 #include "geometry/mesh_topology.h"
 #include "geometry/obj_io.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  subflow::fuzz::QuietLogs();
-  return 0;
-}
+SUBFLOW_FUZZ_QUIET_INITIALIZE()
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

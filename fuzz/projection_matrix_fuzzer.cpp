@@ -1,18 +1,14 @@
-// libFuzzer harness: the projection-matrix importers (vision/projection_matrix_import.h) on a
+// libFuzzer harness: the projection-matrix importers (vision/import_projection_matrices.h) on a
 // fuzzed folder (fuzz/fuzz_support.h): the matrix-file folder (image sizes from the
 // images beside them, or given), and a Middlebury "<name>_par.txt" in it.
 #include "fuzz/fuzz_support.h"
-#include "vision/projection_matrix_import.h"
+#include "vision/import_projection_matrices.h"
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-  subflow::fuzz::QuietLogs();
-  return 0;
-}
+SUBFLOW_FUZZ_QUIET_INITIALIZE()
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace fs = std::filesystem;
-  const auto root = subflow::fuzz::FreshScratch();
-  subflow::fuzz::WriteFileTree(data, size, root);
+  const auto root = subflow::fuzz::TreeOfInput(data, size);
   subflow::vision::ProjectionMatrixImportOptions given_size;
   given_size.width = 64;
   given_size.height = 48;

@@ -19,6 +19,13 @@ void PrepareOutputDirectory(const std::string& directory, bool overwrite) {
     if (!fs::is_empty(directory, error) && !overwrite)
       ThrowError(directory, "",
                  "output directory exists and is not empty; choose another or pass --overwrite");
+    // Replacing a result: remove the previous one's entries, so that none of its files
+    // (a frame beyond the new run's last) passes for part of the new result. Other files
+    // of the directory are the user's and stay.
+    for (const char* entry : kResultEntries) {
+      fs::remove_all(fs::path(directory) / entry, error);
+      if (error) ThrowError((fs::path(directory) / entry).string(), "", "cannot remove: " + error.message());
+    }
     return;
   }
   fs::create_directories(directory, error);

@@ -18,8 +18,14 @@
 
 namespace subflow::output {
 
+// What a result directory holds (this layout and output/result_files.h): the entries
+// --overwrite replaces.
+inline constexpr const char* kResultEntries[] = {"meshes", "report.json", "hull", "base_mesh.ply",
+                                                 "control", "obj"};
+
 // Creates `directory` (and its parents). Throws subflow::Error naming it when it exists
-// and is not empty and `overwrite` is false, or when it cannot be created.
+// and is not empty and `overwrite` is false, or when it cannot be created. With
+// `overwrite`, removes the kResultEntries it holds (other files stay).
 void PrepareOutputDirectory(const std::string& directory, bool overwrite);
 
 // Writes <directory>/meshes/<frame>.ply for frames first_frame + i, i = 0..#positions − 1.

@@ -16,6 +16,7 @@ packages=(
   libpugixml-dev libtomlplusplus-dev  # calibration importers: Qualisys XML, Pose2Sim/Anipose TOML
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmesh-dev  # optional reference in bench/subdivision_bench
+  clang libclang-rt-14-dev  # the fuzz harnesses (libFuzzer, ASan, UBSan): scripts/fuzz.sh
   # Tests of the exports and the viewer: Blender reads the point caches and the .glb
   # (python3-numpy: its glTF importer needs it), Chromium opens the viewer headless.
   blender python3-numpy

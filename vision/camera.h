@@ -27,6 +27,8 @@ namespace subflow::vision {
 // the per-pixel buffers of a camera (images, z-buffers, silhouettes) can be allocated.
 // Readers refuse larger sizes before allocating anything for them.
 inline constexpr int kMaxImageSide = 1 << 15;
+// The most pixels an image may have (16384², ~268 Mpx: beyond 8K video by 8×).
+inline constexpr long long kMaxImagePixels = 1LL << 28;
 
 class Camera {
  public:

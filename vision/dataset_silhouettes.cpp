@@ -17,11 +17,14 @@ namespace subflow::vision {
 
 bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras) {
   int non_empty = 0;
+  bool all_motion = true;
   for (const Silhouette& silhouette : silhouettes) {
-    if (silhouette.source != EvidenceSource::kMotion) return false;
+    all_motion = all_motion && silhouette.source == EvidenceSource::kMotion;
     non_empty += !silhouette.empty;
   }
-  return non_empty < min_cameras;
+  // No camera sees the object (it has left the working volume): nothing to carve.
+  if (non_empty == 0) return true;
+  return all_motion && non_empty < min_cameras;
 }
 
 EvidenceSource AutomaticSource(const Dataset& dataset, int camera) {
@@ -139,9 +142,14 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
 std::vector<Silhouette> ComputeSilhouettes(const Dataset& dataset, int frame,
                                            const SilhouetteOptions& options) {
   std::vector<Silhouette> silhouettes = ComputeFrameEvidence(dataset, frame, options);
+  const bool all_empty = std::all_of(silhouettes.begin(), silhouettes.end(), [](const Silhouette& silhouette) {
+    return silhouette.empty && silhouette.source != EvidenceSource::kMotion;
+  });
   if (LacksEvidence(silhouettes))
     ThrowError(dataset.directory(), "frame " + std::to_string(frame),
-               "no masks, no background, and no motion: cannot find the object");
+               all_empty
+                   ? "every camera's silhouette is empty: cannot find the object"
+                   : "no masks, no background, and no motion: cannot find the object");
   return silhouettes;
 }
 

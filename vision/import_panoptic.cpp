@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/json_reader.h"
 
 namespace subflow::vision {
 namespace {
@@ -34,12 +35,9 @@ Eigen::MatrixXd Numbers(const json& value, int rows, int cols, const std::string
 }  // namespace
 
 Calibration ParsePanopticCalibration(const std::string& text, const std::string& source) {
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::parse_error& e) {
-    ThrowError(source, "JSON at byte " + std::to_string(e.byte), std::string("expected valid JSON: ") + e.what());
-  }
+  // One mapping of JSON failures (core/json_reader.h): a number like 1e999 is an error
+  // naming the field, not an nlohmann exception (found by fuzz/calibration_fuzzer).
+  const json root = ParseJson(text, source, "Panoptic's calibration JSON {\"cameras\": [...]}");
   if (!root.is_object() || !root.contains("cameras") || !root["cameras"].is_array())
     ThrowError(source, "cameras", "missing (expected Panoptic's {\"cameras\": [...]})");
   Calibration calibration;

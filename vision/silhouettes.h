@@ -257,7 +257,8 @@ Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
 // motion. The one rule for shape initialization and the refinement's silhouettes.
 EvidenceSource AutomaticSource(const Dataset& dataset, int camera);
 
-// Whether `silhouettes` say nothing about where the object is: every camera uses motion
+// Whether `silhouettes` say nothing about where the object is: every silhouette is empty
+// (the object has left the working volume in that frame), or every camera uses motion
 // evidence and fewer than `min_cameras` of them have a non-empty silhouette (a frame of a
 // mask-less dataset in which nothing moves within the motion window).
 bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras = 1);

@@ -17,9 +17,16 @@ namespace {
 
 // Frames without evidence take the hull and carving figures of the nearest frame with
 // evidence (the earlier one on a tie), with a warning; an error when no frame has any.
+// all_empty[i]: every silhouette of frame i is empty and none is motion evidence (the
+// object has left the volume).
 void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std::vector<bool>& has_evidence,
-                                      int min_cameras, std::vector<FrameShapeInit>* frames) {
+                                      const std::vector<bool>& all_empty, int min_cameras,
+                                      std::vector<FrameShapeInit>* frames) {
   const int count = static_cast<int>(frames->size());
+  const std::string frame_range =
+      "frames " + std::to_string(frames->front().frame) + ".." + std::to_string(frames->back().frame);
+  if (std::find(all_empty.begin(), all_empty.end(), false) == all_empty.end())
+    ThrowError(dataset.directory(), frame_range, "every camera's silhouette is empty in every frame: cannot find the object");
   if (std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end())
     ThrowError(dataset.directory(),
                "frames " + std::to_string(frames->front().frame) + ".." + std::to_string(frames->back().frame),
@@ -40,7 +47,9 @@ void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std:
     frame.carving.warnings.clear();
     frame.isosurface = taken.isosurface;
     frame.hull = taken.hull;
-    const std::string warning =
+    const std::string warning = all_empty[i] ?
+        "frame " + std::to_string(frame.frame) + ": every camera's silhouette is empty (the object has left the "
+        "working volume): hull of frame " + std::to_string(taken.frame) + " used" :
         "frame " + std::to_string(frame.frame) + ": no masks, no background, and motion evidence in fewer than " +
         std::to_string(min_cameras) + " camera(s) (nothing moves): hull of frame " + std::to_string(taken.frame) +
         " used";
@@ -109,7 +118,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     }
 
   // Visual hull of every frame with evidence.
-  std::vector<bool> has_evidence(count, false);
+  std::vector<bool> has_evidence(count, false), all_empty(count, false);
   ProgressBegin(progress, "visual hull", count);
   for (int i = 0; i < count; ++i) {
     FrameShapeInit& frame = result.frames[i];
@@ -118,6 +127,11 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     const std::vector<vision::Silhouette> silhouettes =
         vision::ComputeFrameEvidence(dataset, frame.frame, options.silhouettes, &result.estimated_backgrounds);
     has_evidence[i] = !vision::LacksEvidence(silhouettes, options.carving.min_cameras);
+    // Empty masks or background differences say the object is absent (motion evidence only
+    // that nothing moves).
+    all_empty[i] = std::all_of(silhouettes.begin(), silhouettes.end(), [](const vision::Silhouette& silhouette) {
+      return silhouette.empty && silhouette.source != vision::EvidenceSource::kMotion;
+    });
     if (has_evidence[i]) {
       frame.carving = vision::CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), options.carving,
                                           frame.frame);
@@ -133,7 +147,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   ProgressEnd(progress);
   for (vision::EstimatedBackground& estimated : result.estimated_backgrounds)  // memory: keep the figures
     estimated.image.release(), estimated.known.release();
-  TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, options.carving.min_cameras, &result.frames);
+  TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames);
 
   // Base mesh and hierarchy from the reference frame.
   Stopwatch start;

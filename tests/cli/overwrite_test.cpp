@@ -170,6 +170,20 @@ TEST(Overwrite, EveryWritingCommandRefusesAnExistingOutputAndLeavesItUntouched) 
   }
 }
 
+TEST(Overwrite, OverwritingAResultLeavesNoFileOfThePreviousOne) {
+  const fs::path out = Scratch().FreshPath("shorter");
+  const std::string hull = "hull " + Quoted(TinyDataset()) + " --out " + Quoted(out) + HullOptions();
+  ASSERT_EQ(test::RunSubflow(hull, Scratch().path()).exit_code, 0);
+  ASSERT_TRUE(fs::exists(out / "meshes" / "000001.ply"));
+  std::ofstream(out / "notes.txt") << "the user's notes\n";
+  const test::CommandResult shorter = test::RunSubflow(hull + " --frames 1 --overwrite", Scratch().path());
+  ASSERT_EQ(shorter.exit_code, 0) << shorter.output();
+  EXPECT_TRUE(fs::exists(out / "meshes" / "000000.ply"));
+  EXPECT_FALSE(fs::exists(out / "meshes" / "000001.ply")) << "a frame of the previous result is left";
+  EXPECT_FALSE(fs::exists(out / "hull" / "000001.ply")) << "a hull of the previous result is left";
+  EXPECT_EQ(test::ReadTextFile(out / "notes.txt"), "the user's notes\n");
+}
+
 TEST(Overwrite, AnOutputFileThatIsADirectoryOrInAMissingDirectoryIsRefused) {
   const fs::path directory = Scratch().Subdirectory("a_directory.ply");
   test::CommandResult run = test::RunSubflow(Commands().at("subdivide")->arguments(directory), Scratch().path());

@@ -81,6 +81,10 @@ TEST(CamerasJson, SizesAndCountsBeyondTheLimitsAreRefused) {
                              "expected an integer in [1, 32768]");
   ExpectFileFieldExpectation(CamerasJson("400", "18446744073709551616"), "cameras[0] (\"cam0\").width",
                              "expected an integer in [1, 32768]");
+  // Each side within the limit, but 2^30 pixels: refused before any image is allocated.
+  std::string square = CamerasJson("400", "32768");
+  square.replace(square.find("\"height\": 48"), 12, "\"height\": 32768");
+  ExpectFileFieldExpectation(square, "camera \"cam0\": width × height", "expected at most 268435456 pixels");
   ExpectFileFieldExpectation(CamerasJson("400", "64.5"), "cameras[0] (\"cam0\").width",
                              "expected an integer");
   ExpectFileFieldExpectation(CamerasJson("400", "64", "\n \"frame_count\": 1000000000,"), "frame_count",
