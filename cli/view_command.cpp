@@ -25,6 +25,8 @@ struct ViewArguments {
   std::optional<double> fps;
   bool no_texture = false;
   bool overwrite = false;
+  int stride = 0;
+  double max_megabytes = 256;
 };
 
 void RunView(const ViewArguments& arguments) {
@@ -38,6 +40,8 @@ void RunView(const ViewArguments& arguments) {
   output::ViewerOptions options;
   options.texture = !arguments.no_texture;
   options.title = arguments.result;
+  options.stride = arguments.stride;
+  options.max_bytes = static_cast<std::size_t>(arguments.max_megabytes * (1 << 20));
   ProgressBar progress;
   const output::ViewerSummary summary =
       output::WriteViewer(result, dataset.get(), metadata, arguments.out, options, &progress);
@@ -48,10 +52,19 @@ void RunView(const ViewArguments& arguments) {
                                                          {"out", arguments.out},
                                                          {"bytes", summary.bytes},
                                                          {"colourings", summary.colourings},
+                                                         {"stride", summary.stride},
+                                                         {"frames_in_page", summary.frames_in_page},
+                                                         {"max_megabytes", arguments.max_megabytes},
                                                          {"fps", metadata.fps},
                                                          {"fps_source", metadata.fps_source},
                                                          {"seconds", stopwatch.Seconds()}});
-  std::cout << arguments.out << ": " << result.frame_count() << " frames of " << result.vertex_count()
+  if (arguments.stride == 0 && summary.stride > 1)
+    std::cerr << "warning: " << arguments.out << ": every frame would make a page of about "
+              << summary.estimated_bytes_all_frames / (1 << 20) << " MB (over --max-megabytes "
+              << arguments.max_megabytes << "): the page holds every " << summary.stride << "th frame ("
+              << summary.frames_in_page << " of " << result.frame_count()
+              << "); choose with --stride, or export a .glb / point cache for every frame\n";
+  std::cout << arguments.out << ": " << summary.frames_in_page << " frames of " << result.vertex_count()
             << " vertices, " << summary.bytes << " bytes, colourings";
   for (const std::string& name : summary.colourings) std::cout << " " << name;
   std::cout << " in " << stopwatch.Seconds() << " s\n";
@@ -69,6 +82,10 @@ Command AddViewCommand(CLI::App& app) {
   command->add_option("--dataset", arguments->dataset, "The result's dataset, for the texture colouring and the up "
                       "direction (default: report.json's dataset.directory)");
   command->add_option("--fps", arguments->fps, "Playback frame rate (default: the result's)");
+  command->add_option("--stride", arguments->stride, "Put every K-th frame into the page (default: 1, or the "
+                      "smallest K that keeps the page under --max-megabytes)")->check(CLI::PositiveNumber);
+  command->add_option("--max-megabytes", arguments->max_megabytes, "Size cap of the page when --stride is not given "
+                      "(browsers refuse a page's data over ~512 MB)")->check(CLI::Range(1.0, 480.0));
   command->add_flag("--no-texture", arguments->no_texture, "No texture colouring (smaller page, no dataset read)");
   command->add_flag("--overwrite", arguments->overwrite, "Replace an existing page");
   command->footer("Example: subflow view out/result --out blob.html && chromium blob.html");

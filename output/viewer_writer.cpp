@@ -49,6 +49,21 @@ std::string Page(const nlohmann::json& data) {
 
 }  // namespace
 
+std::size_t EstimatedViewerBytes(std::size_t vertex_count, std::size_t frames, std::size_t magnitude_channels,
+                                 bool texture) {
+  // float32 x y z and one float32 per magnitude channel, 3 bytes of sRGB; base64 is 4/3.
+  const std::size_t per_vertex = 12 + 4 * magnitude_channels + (texture ? 3 : 0);
+  return frames * vertex_count * per_vertex / 3 * 4;
+}
+
+int ViewerStride(const ViewerOptions& options, std::size_t vertex_count, std::size_t frames,
+                 std::size_t magnitude_channels, bool texture) {
+  if (options.stride > 0) return options.stride;
+  const std::size_t per_frame = std::max<std::size_t>(1, EstimatedViewerBytes(vertex_count, 1, magnitude_channels, texture));
+  const std::size_t fitting = std::max<std::size_t>(1, options.max_bytes / per_frame);  // frames that fit
+  return static_cast<int>((frames + fitting - 1) / fitting);
+}
+
 ViewerSummary WriteViewer(const ResultReader& result, const vision::Dataset* dataset, const ResultMetadata& metadata,
                           const std::string& path, const ViewerOptions& options, Progress* progress) {
   if (!ViewerAvailable())
@@ -59,20 +74,28 @@ ViewerSummary WriteViewer(const ResultReader& result, const vision::Dataset* dat
   std::vector<FlowRange> ranges;
   for (FlowKind kind : kinds) ranges.push_back(SequenceFlowRange(result, kind));
   const bool texture = options.texture && dataset;
+  const auto vertex_count = static_cast<std::size_t>(result.vertex_count());
+  const auto frame_count = static_cast<std::size_t>(result.frame_count());
+  ViewerSummary summary;
+  summary.stride = ViewerStride(options, vertex_count, frame_count, kinds.size(), texture);
+  summary.estimated_bytes_all_frames = EstimatedViewerBytes(vertex_count, frame_count, kinds.size(), texture);
 
   std::vector<float> positions;
   std::vector<std::vector<float>> magnitudes(kinds.size());
   std::vector<std::uint8_t> rgb;
   nlohmann::json frame_names = nlohmann::json::array();
-  ProgressBegin(progress, "viewer", static_cast<std::size_t>(result.frame_count()));
+  ProgressBegin(progress, "viewer", frame_count);
+  std::size_t visited = 0;
   ForEachFrameFlow(result, kinds, [&](const ResultFrame& frame, const std::vector<Eigen::VectorXf>& values) {
+    ProgressUpdate(progress, ++visited);
+    if ((visited - 1) % static_cast<std::size_t>(summary.stride) != 0) return;
     for (Eigen::Index k = 0; k < frame.V.size(); ++k) positions.push_back(static_cast<float>(frame.V.data()[k]));
     for (std::size_t k = 0; k < kinds.size(); ++k)
       magnitudes[k].insert(magnitudes[k].end(), values[k].data(), values[k].data() + values[k].size());
     if (texture) AppendTexture(*dataset, frame, result.faces(), &rgb);
     frame_names.push_back(vision::FrameName(frame.frame));
-    ProgressUpdate(progress, static_cast<std::size_t>(frame_names.size()));
   });
+  summary.frames_in_page = static_cast<int>(frame_names.size());
   ProgressEnd(progress);
 
   const std::vector<std::uint32_t> indices(result.faces().data(), result.faces().data() + result.faces().size());
@@ -81,15 +104,15 @@ ViewerSummary WriteViewer(const ResultReader& result, const vision::Dataset* dat
   const Eigen::Vector3d up = dataset ? CamerasUp(dataset->cameras()) : Eigen::Vector3d::UnitZ();
   nlohmann::json data = {{"title", options.title},
                          {"vertex_count", result.vertex_count()},
-                         {"frame_count", result.frame_count()},
+                         {"frame_count", summary.frames_in_page},
                          {"frame_names", frame_names},
-                         {"fps", metadata.fps},
+                         {"stride", summary.stride},
+                         {"fps", metadata.fps / summary.stride},  // page frames per second of real time
                          {"up", {up.x(), up.y(), up.z()}},
                          {"positions", Base64Of(positions)},
                          {"indices", Base64Of(indices)},
                          {"colour_table", table},
                          {"colourings", nlohmann::json::object()}};
-  ViewerSummary summary;
   for (std::size_t k = 0; k < kinds.size(); ++k) {
     const std::string name = kinds[k] == FlowKind::kTotal ? "flow" : "nonrigid";
     data["colourings"][name] = {{"title", kinds[k] == FlowKind::kTotal ? "scene flow" : "non-rigid flow"},

@@ -25,12 +25,29 @@ namespace subflow::output {
 struct ViewerOptions {
   bool texture = true;        // the texture colouring (needs the dataset's images)
   std::string title = "subflow result";
+  // Every `stride`-th frame goes into the page (playback keeps real time: fps / stride).
+  // 0: automatic, the smallest stride whose page stays under `max_bytes`. The cap exists
+  // because the page's data is one JavaScript string: V8 refuses strings over 2^29 − 24
+  // characters (~512 MiB), and a page of several hundred MB takes minutes to open.
+  int stride = 0;
+  std::size_t max_bytes = std::size_t(256) << 20;
 };
 
 struct ViewerSummary {
   std::size_t bytes = 0;
   std::vector<std::string> colourings;
+  int stride = 1;            // the stride used
+  int frames_in_page = 0;    // frames written into the page
+  std::size_t estimated_bytes_all_frames = 0;  // the page's size estimate with every frame
 };
+
+// The page's size estimate for `frames` frames of `vertex_count` vertices with
+// `magnitude_channels` flow colourings and, if `texture`, the texture colouring; and the
+// stride that options.stride (or the automatic choice) gives for a result of that shape.
+std::size_t EstimatedViewerBytes(std::size_t vertex_count, std::size_t frames, std::size_t magnitude_channels,
+                                 bool texture);
+int ViewerStride(const ViewerOptions& options, std::size_t vertex_count, std::size_t frames,
+                 std::size_t magnitude_channels, bool texture);
 
 // Throws subflow::Error when this build has no viewer (ViewerAvailable() false).
 ViewerSummary WriteViewer(const ResultReader& result, const vision::Dataset* dataset, const ResultMetadata& metadata,

@@ -116,6 +116,32 @@ TEST(ViewCommand, SurfaceCoversThePictureAndMovesBetweenFrames) {
   EXPECT_GT(shift, 10.0) << "the surface's centroid moved " << shift << " px";
 }
 
+// Every second frame of the 5: frames 0, 2, 4 in the page, played at half the rate so
+// that time stays real, and the report says so.
+TEST(ViewCommand, StrideKeepsEveryKthFrame) {
+  test::TinyResultOptions options;
+  test::WriteTinyResult(Scratch() / "strided_result", options);
+  const fs::path page = Scratch() / "strided.html";
+  const test::CommandResult run =
+      RunSubflow("view " + Quote(Scratch() / "strided_result") + " --stride 2 --out " + Quote(page), Scratch().path());
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  const nlohmann::json report = nlohmann::json::parse(test::ReadTextFile(page.string() + ".report.json"));
+  EXPECT_EQ(report["stride"], 2);
+  EXPECT_EQ(report["frames_in_page"], 3);
+  const std::string html = test::ReadTextFile(page);
+  EXPECT_NE(html.find("\"frame_names\":[\"000000\",\"000002\",\"000004\"]"), std::string::npos)
+      << html.substr(0, 400);
+  EXPECT_NE(html.find("\"fps\":12.5"), std::string::npos);
+}
+
+TEST(ViewCommand, RefusesAnAbsurdSizeCap) {
+  const test::CommandResult run = RunSubflow("view " + Quote(Scratch() / "result") + " --max-megabytes 0 --out " +
+                                                 Quote(Scratch() / "never.html"), Scratch().path());
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("--max-megabytes"), std::string::npos) << run.output();
+  EXPECT_FALSE(fs::exists(Scratch() / "never.html"));
+}
+
 TEST(ViewCommand, RefusesToOverwrite) {
   const fs::path page = Page();
   const test::CommandResult again = RunSubflow("view " + Quote(Scratch() / "result") + " --out " + Quote(page), Scratch().path());

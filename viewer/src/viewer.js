@@ -125,7 +125,7 @@ const colourSelect = document.getElementById('colour');
 slider.max = String(frameCount - 1);
 for (const name of Object.keys(colourings)) colourSelect.add(new Option(colourings[name].title, name));
 colourSelect.value = colouring;
-document.getElementById('title').textContent = `${data.title}: ${frameCount} frames, ${vertexCount} vertices, ${data.fps} fps`;
+document.getElementById('title').textContent = `${data.title}: ${frameCount} frames${data.stride > 1 ? ` (every ${data.stride}th)` : ''}, ${vertexCount} vertices, ${data.fps * (data.stride || 1)} fps`;
 playButton.textContent = playing ? 'Pause' : 'Play';
 slider.addEventListener('input', () => { playing = false; playButton.textContent = 'Play'; showFrame(parseInt(slider.value, 10)); });
 playButton.addEventListener('click', () => { playing = !playing; playButton.textContent = playing ? 'Pause' : 'Play'; start = performance.now() - (frame / data.fps) * 1000; });
