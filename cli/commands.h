@@ -22,7 +22,13 @@ Command AddCheckCommand(CLI::App& app);  // cli/check_command.cpp
 Command AddSynthCommand(CLI::App& app);  // cli/synth_command.cpp
 Command AddEvalCommand(CLI::App& app);   // cli/eval_command.cpp
 Command AddSubdivideCommand(CLI::App& app);  // cli/subdivide_command.cpp
-Command AddHullCommand(CLI::App& app);       // cli/hull_command.cpp
+Command AddShapeCommand(CLI::App& app);       // cli/stage_commands.cpp
+Command AddHullCommand(CLI::App& app);        // cli/stage_commands.cpp (= shape)
+Command AddMotionCommand(CLI::App& app);      // cli/stage_commands.cpp
+Command AddRefineCommand(CLI::App& app);      // cli/stage_commands.cpp
+Command AddRetrackCommand(CLI::App& app);     // cli/stage_commands.cpp
+Command AddSplitCommand(CLI::App& app);       // cli/stage_commands.cpp
+Command AddMergeCommand(CLI::App& app);       // cli/stage_commands.cpp
 Command AddReconstructCommand(CLI::App& app);  // cli/reconstruct_command.cpp
 Command AddExportCommand(CLI::App& app);       // cli/export_command.cpp
 Command AddImportCommand(CLI::App& app);       // cli/import_command.cpp
@@ -35,7 +41,13 @@ inline std::vector<AddCommandFunction> AllCommands() {
       AddSynthCommand,
       AddEvalCommand,
       AddSubdivideCommand,
+      AddShapeCommand,
       AddHullCommand,
+      AddMotionCommand,
+      AddRefineCommand,
+      AddRetrackCommand,
+      AddSplitCommand,
+      AddMergeCommand,
       AddReconstructCommand,
       AddExportCommand,
       AddImportCommand,

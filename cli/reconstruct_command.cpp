@@ -1,7 +1,8 @@
 // `subflow reconstruct DATASET --out DIR`: the product's main job, start to finish —
 // shape initialization → motion initialization → stereo refinement (unless --no-refine)
-// → re-tracking → rigid / non-rigid split; writes the files of
-// output/reconstruction_writer.h.
+// → re-tracking → rigid / non-rigid split (output/stage_pipeline.h: the stages of the
+// stage commands, each writing its stage folder DIR/stages/<stage>/; --resume reuses the
+// complete ones of an interrupted run).
 #include <memory>
 
 #include <spdlog/spdlog.h>
@@ -10,9 +11,8 @@
 #include "cli/progress_bar.h"
 #include "cli/stage_options.h"
 #include "core/stopwatch.h"
-#include "output/reconstruction_writer.h"
 #include "output/result_writer.h"
-#include "solver/reconstruction.h"
+#include "output/stage_pipeline.h"
 #include "vision/dataset.h"
 
 namespace subflow::cli {
@@ -22,6 +22,7 @@ struct ReconstructArguments {
   std::string dataset;
   std::string out;
   bool overwrite = false;
+  bool resume = false;
   bool no_refine = false;
   std::string evidence = "auto";
   solver::ReconstructionOptions options;
@@ -34,13 +35,12 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   options.refine = !arguments.no_refine;
   options.Check();
   const vision::Dataset dataset(arguments.dataset);
-  output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  output::PrepareOutputDirectory(arguments.out, arguments.overwrite, arguments.resume);
   ProgressBar progress;
-  const solver::ReconstructionResult result = solver::Reconstruct(dataset, options, &progress);
   const std::string command = arguments.no_refine ? "reconstruct --no-refine" : "reconstruct";
-  output::WriteReconstruction({command, arguments.out, arguments.overwrite}, dataset, options, result, start);
-  spdlog::info("reconstruct: {} frames written to {} in {:.1f} s\n{}", result.control.size(), arguments.out,
-               start.Seconds(), result.BriefReport());
+  const nlohmann::json stages = output::RunReconstruction({command, arguments.out, arguments.overwrite, arguments.resume}, dataset,
+                                                          options, arguments.resume, &progress, start);
+  spdlog::info("reconstruct: written to {} in {:.1f} s (stages: {})", arguments.out, start.Seconds(), stages.dump());
 }
 
 }  // namespace
@@ -51,6 +51,9 @@ Command AddReconstructCommand(CLI::App& app) {
       "reconstruct", "Multi-view video → time-varying Loop subdivision surface with scene flow "
                      "(shape init, motion init, spatio-temporal stereo, rigid/non-rigid split)");
   AddDatasetAndOutput(sub, &arguments->dataset, &arguments->out, &arguments->overwrite);
+  sub->add_flag("--resume", arguments->resume,
+                "Continue an interrupted run in --out: complete stage folders (OUT/stages/) written with the "
+                "same options are loaded instead of recomputed");
   sub->add_flag("--no-refine", arguments->no_refine,
                 "Stop after motion initialization (no spatio-temporal stereo refinement)");
   sub->add_flag("!--no-retrack", arguments->options.retrack,

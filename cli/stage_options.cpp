@@ -11,6 +11,36 @@ void AddDatasetAndOutput(CLI::App* sub, std::string* dataset, std::string* out, 
   sub->add_flag("--overwrite", *overwrite, "Write into a non-empty output directory");
 }
 
+void AddFramesOption(CLI::App* sub, int* first, int* count, bool allow_count) {
+  sub->add_option_function<std::string>(
+         "--frames",
+         [first, count, allow_count](const std::string& text) {
+           const std::size_t colon = text.find(':');
+           try {
+             std::size_t used = 0;
+             if (colon == std::string::npos && allow_count) {
+               *count = std::stoi(text, &used);
+               if (used == text.size() && (*count > 0 || *count == -1)) return;
+             } else if (colon != std::string::npos) {
+               const int a = std::stoi(text.substr(0, colon), &used);
+               const bool whole_a = used == colon;
+               const int b = std::stoi(text.substr(colon + 1), &used);
+               if (whole_a && used == text.size() - colon - 1 && a >= 0 && b > a) {
+                 *first = a;
+                 *count = b - a;
+                 return;
+               }
+             }
+           } catch (const std::exception&) {
+           }
+           throw CLI::ValidationError("--frames", "'" + text + "': expected A:B (frames A to B - 1, 0 <= A < B)" +
+                                                     std::string(allow_count ? " or a frame count N" : ""));
+         },
+         allow_count ? "Frames A:B (A to B - 1), or a count N from --first-frame (-1 = to the end)"
+                     : "Frames A:B (A to B - 1) of the input stage folder to run on (default: all)")
+      ->type_name(allow_count ? "A:B|N" : "A:B");
+}
+
 void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string* evidence) {
   sub->add_option("--evidence", *evidence,
                   "Object evidence: auto (masks, else background, else motion), mask, background, motion")
@@ -21,7 +51,7 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
   sub->add_option("--reference-frame", o->reference_frame,
                   "Frame giving the base connectivity (-1 = middle frame)")->capture_default_str();
   sub->add_option("--first-frame", o->first_frame, "First frame to process")->capture_default_str();
-  sub->add_option("--frames", o->frame_count, "Number of frames (-1 = to the end)")->capture_default_str();
+  AddFramesOption(sub, &o->first_frame, &o->frame_count, true);
   sub->add_option("--resolution", o->carving.resolution,
                   "Voxels along the longest axis of the working volume (0 = automatic, ~2 px per voxel)")
       ->capture_default_str();

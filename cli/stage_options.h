@@ -15,6 +15,10 @@ namespace subflow::cli {
 // subcommand that reads a dataset and writes a result directory.
 void AddDatasetAndOutput(CLI::App* app, std::string* dataset, std::string* out, bool* overwrite);
 
+// --frames A:B (dataset frames A..B−1: *first = A, *count = B − A), or, with
+// `allow_count`, --frames N (*count = N, −1 = to the end; *first unchanged).
+void AddFramesOption(CLI::App* app, int* first, int* count, bool allow_count);
+
 // --evidence, --levels, --base-faces, --reference-frame, --first-frame, --frames,
 // --resolution, --min-cameras, --max-misses, --evidence-threshold, --footprint-margin,
 // --lambda, --motion-window, --motion-threshold, --background-threshold (out-of-range values

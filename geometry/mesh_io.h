@@ -34,7 +34,9 @@ struct MeshReadOptions {
 TriangleMesh ReadMesh(const std::string& path, const MeshReadOptions& options = {},
                       VertexProperties* properties = nullptr);
 
-enum class PlyFormat { kAscii, kBinaryLittleEndian };
+// kBinaryLittleEndianDouble stores x y z and the properties as double: the exact values,
+// for files a later run reads back (the stage folders of docs/stages.md).
+enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryLittleEndianDouble };
 
 // Writes .ply (binary little-endian by default: float x y z [+ properties], faces as
 // "uchar int" lists) or .obj, by extension. The directory must exist; OBJ cannot hold

@@ -29,7 +29,8 @@ TriangleMesh ParsePly(const std::string& bytes, const std::string& source,
                       VertexProperties* properties = nullptr);
 
 // Writes `mesh` as PLY: float x y z [+ properties as float, in properties->names order,
-// or the map's key order when names is empty], faces as "list uchar int vertex_indices".
+// or the map's key order when names is empty], faces as "list uchar int vertex_indices";
+// double instead of float for kBinaryLittleEndianDouble.
 // ASCII floats carry 9 significant digits, so both formats store exactly the float
 // values. `source` names the destination in errors (property size mismatches).
 void WritePly(std::ostream& out, const TriangleMesh& mesh, const VertexProperties* properties,

@@ -26,6 +26,13 @@ void AppendFloat(std::string* buffer, float value, bool swap) {
   buffer->append(reinterpret_cast<const char*>(raw), 4);
 }
 
+void AppendDouble(std::string* buffer, double value, bool swap) {
+  unsigned char raw[8];
+  std::memcpy(raw, &value, 8);
+  if (swap) std::reverse(raw, raw + 8);
+  buffer->append(reinterpret_cast<const char*>(raw), 8);
+}
+
 void AppendInt32(std::string* buffer, std::int32_t value, bool swap) {
   unsigned char raw[4];
   std::memcpy(raw, &value, 4);
@@ -75,11 +82,13 @@ void WritePly(std::ostream& out, const TriangleMesh& mesh, const VertexPropertie
                  "non-finite coordinate (refusing to write it)");
 
   std::string text = "ply\nformat ";
+  const bool exact = format == PlyFormat::kBinaryLittleEndianDouble;
+  const std::string scalar = exact ? "double" : "float";
   text += format == PlyFormat::kAscii ? "ascii 1.0\n" : "binary_little_endian 1.0\n";
   text += "comment written by subflow\n";
   text += "element vertex " + std::to_string(n) + "\n";
-  text += "property float x\nproperty float y\nproperty float z\n";
-  for (const std::string& name : names) text += "property float " + name + "\n";
+  for (const char* axis : {"x", "y", "z"}) text += "property " + scalar + " " + axis + "\n";
+  for (const std::string& name : names) text += "property " + scalar + " " + name + "\n";
   text += "element face " + std::to_string(m) + "\n";
   text += "property list uchar int vertex_indices\nend_header\n";
 
@@ -103,13 +112,17 @@ void WritePly(std::ostream& out, const TriangleMesh& mesh, const VertexPropertie
               std::to_string(mesh.F(f, 2)) + "\n";
   } else {
     const bool swap = HostIsBigEndian();
-    text.reserve(text.size() + static_cast<size_t>(n) * 4 * (3 + names.size()) +
+    text.reserve(text.size() + static_cast<size_t>(n) * (exact ? 8 : 4) * (3 + names.size()) +
                  static_cast<size_t>(m) * 13);
+    const auto append = [&](double value) {
+      if (exact)
+        AppendDouble(&text, value, swap);
+      else
+        AppendFloat(&text, static_cast<float>(value), swap);
+    };
     for (int v = 0; v < n; ++v) {
-      for (int axis = 0; axis < 3; ++axis)
-        AppendFloat(&text, static_cast<float>(mesh.V(v, axis)), swap);
-      for (const Eigen::VectorXd* column : columns)
-        AppendFloat(&text, static_cast<float>((*column)(v)), swap);
+      for (int axis = 0; axis < 3; ++axis) append(mesh.V(v, axis));
+      for (const Eigen::VectorXd* column : columns) append((*column)(v));
     }
     for (int f = 0; f < m; ++f) {
       text += static_cast<char>(3);

@@ -51,6 +51,7 @@ nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset)
   return {{"command", run.command},
           {"output", run.out},
           {"overwrite", run.overwrite},
+          {"resume", run.resume},
           {"versions", VersionsJson()},
           {"dataset", DatasetJson(dataset)}};
 }

@@ -26,9 +26,10 @@ struct CommandRun {
   std::string command;
   std::string out;
   bool overwrite = false;
+  bool resume = false;  // reconstruct --resume
 };
 
-// {"command", "output", "overwrite", "versions", "dataset"}: the head of every report.
+// {"command", "output", "overwrite", "resume", "versions", "dataset"}: the head of every report.
 nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset);
 
 // Figures of shape initialization: reference frame, base mesh, levels, the backgrounds

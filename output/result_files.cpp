@@ -2,31 +2,50 @@
 
 #include <filesystem>
 
-#include "geometry/mesh_io.h"
 #include "vision/dataset.h"
 
 namespace subflow::output {
 
 namespace fs = std::filesystem;
 
-void WriteHullFiles(const std::string& out, const solver::ShapeInitResult& result) {
+void WriteHullFiles(const std::string& out, const geometry::TriangleMesh& base_mesh, int first_frame,
+                    const std::vector<geometry::TriangleMesh>& hulls, geometry::PlyFormat format) {
   const fs::path root(out);
   fs::create_directories(root / "hull");
-  geometry::WriteMesh((root / "base_mesh.ply").string(), result.base_mesh);
-  for (const solver::FrameShapeInit& frame : result.frames)
-    geometry::WriteMesh((root / "hull" / (vision::FrameName(frame.frame) + ".ply")).string(), frame.hull);
+  geometry::WriteMesh((root / "base_mesh.ply").string(), base_mesh, nullptr, format);
+  for (std::size_t i = 0; i < hulls.size(); ++i)
+    geometry::WriteMesh((root / "hull" / (vision::FrameName(first_frame + static_cast<int>(i)) + ".ply")).string(),
+                        hulls[i], nullptr, format);
 }
 
-void WriteControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy,
-                       int first_frame, const std::vector<std::vector<geometry::Positions>>& levels) {
-  for (std::size_t i = 0; i < levels.size(); ++i) {
-    const fs::path directory =
-        fs::path(out) / "control" / vision::FrameName(first_frame + static_cast<int>(i));
-    fs::create_directories(directory);
+std::string ControlFilePath(const std::string& out, int frame, int level) {
+  return (fs::path(out) / "control" / vision::FrameName(frame) / ("level_" + std::to_string(level) + ".ply"))
+      .string();
+}
+
+namespace {
+
+void WriteControlFile(const std::string& out, const geometry::LoopHierarchy& hierarchy, int frame, int level,
+                      const geometry::Positions& control, geometry::PlyFormat format) {
+  const std::string path = ControlFilePath(out, frame, level);
+  fs::create_directories(fs::path(path).parent_path());
+  geometry::WriteMesh(path, geometry::TriangleMesh{control, hierarchy.LevelFaces(level)}, nullptr, format);
+}
+
+}  // namespace
+
+void WriteControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int first_frame,
+                       const std::vector<std::vector<geometry::Positions>>& levels, geometry::PlyFormat format) {
+  for (std::size_t i = 0; i < levels.size(); ++i)
     for (std::size_t level = 0; level < levels[i].size(); ++level)
-      geometry::WriteMesh((directory / ("level_" + std::to_string(level) + ".ply")).string(),
-                          geometry::TriangleMesh{levels[i][level], hierarchy.LevelFaces(static_cast<int>(level))});
-  }
+      WriteControlFile(out, hierarchy, first_frame + static_cast<int>(i), static_cast<int>(level), levels[i][level],
+                       format);
+}
+
+void WriteFinestControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int first_frame,
+                             const std::vector<geometry::Positions>& finest, geometry::PlyFormat format) {
+  for (std::size_t i = 0; i < finest.size(); ++i)
+    WriteControlFile(out, hierarchy, first_frame + static_cast<int>(i), hierarchy.finest_level(), finest[i], format);
 }
 
 void WriteObjSequence(const std::string& out, int first_frame, const geometry::Faces& faces,

@@ -11,18 +11,19 @@ namespace subflow::output {
 
 namespace fs = std::filesystem;
 
-void PrepareOutputDirectory(const std::string& directory, bool overwrite) {
+void PrepareOutputDirectory(const std::string& directory, bool overwrite, bool resume) {
   std::error_code error;
   if (fs::exists(directory, error)) {
     if (!fs::is_directory(directory, error))
       ThrowError(directory, "", "exists and is not a directory");
-    if (!fs::is_empty(directory, error) && !overwrite)
+    if (!fs::is_empty(directory, error) && !overwrite && !resume)
       ThrowError(directory, "",
                  "output directory exists and is not empty; choose another or pass --overwrite");
     // Replacing a result: remove the previous one's entries, so that none of its files
     // (a frame beyond the new run's last) passes for part of the new result. Other files
     // of the directory are the user's and stay.
     for (const char* entry : kResultEntries) {
+      if (resume && std::string(entry) == "stages") continue;
       fs::remove_all(fs::path(directory) / entry, error);
       if (error) ThrowError((fs::path(directory) / entry).string(), "", "cannot remove: " + error.message());
     }

@@ -20,13 +20,16 @@ namespace subflow::output {
 
 // What a result directory holds (this layout and output/result_files.h): the entries
 // --overwrite replaces.
+// "stages" holds reconstruct's stage folders (docs/stages.md).
 inline constexpr const char* kResultEntries[] = {"meshes", "report.json", "hull", "base_mesh.ply",
-                                                 "control", "obj"};
+                                                 "control", "obj", "stages"};
 
 // Creates `directory` (and its parents). Throws subflow::Error naming it when it exists
-// and is not empty and `overwrite` is false, or when it cannot be created. With
-// `overwrite`, removes the kResultEntries it holds (other files stay).
-void PrepareOutputDirectory(const std::string& directory, bool overwrite);
+// and is not empty and neither `overwrite` nor `resume` is set, or when it cannot be
+// created. With `overwrite`, removes the kResultEntries it holds (other files stay); with
+// `resume` (reconstruct --resume), the same but for "stages", whose complete stage
+// folders the run reuses.
+void PrepareOutputDirectory(const std::string& directory, bool overwrite, bool resume = false);
 
 // Writes <directory>/meshes/<frame>.ply for frames first_frame + i, i = 0..#positions − 1.
 // positions[i] is the tessellation's #V×3 vertices at that frame (all the same #V), faces

@@ -1,8 +1,8 @@
 #include "solver/reconstruction.h"
 
+#include <algorithm>
+
 #include "core/error.h"
-#include "core/stopwatch.h"
-#include "vision/image_sequence.h"
 
 namespace subflow::solver {
 
@@ -20,60 +20,103 @@ MotionInitOptions ReconstructionOptions::RetrackOptions() const {
   return retrack;
 }
 
-std::string ReconstructionResult::BriefReport() const {
-  std::string lines = shape.BriefReport() + "\n" + motion.BriefReport();
-  if (refinement) lines += "\n" + refinement->BriefReport();
-  if (retrack) lines += "\nretrack: " + retrack->BriefReport();
-  return lines + "\n" + split.BriefReport();
-}
-
-geometry::Positions ReconstructionResult::Surface(int i) const {
-  const geometry::LoopHierarchy& h = hierarchy();
-  return h.LimitPositions(h.finest_level()) * control.at(i);
-}
-
-ReconstructionResult Reconstruct(const vision::Dataset& dataset, const ReconstructionOptions& options,
-                                 Progress* progress) {
-  options.Check();
-  ReconstructionResult result;
-
-  Stopwatch start;
-  result.shape = InitializeShape(dataset, options.shape, progress);
-  result.shape_seconds = start.Seconds();
-  const geometry::LoopHierarchy& hierarchy = result.hierarchy();
-  const int finest = hierarchy.finest_level();
-  result.first_frame = result.shape.frames.front().frame;
-  const int frames = static_cast<int>(result.shape.frames.size());
-  std::vector<geometry::TriangleMesh> hulls;
-  for (const FrameShapeInit& frame : result.shape.frames) hulls.push_back(frame.hull);
-  const vision::ImageSequence images = vision::DatasetImages(dataset, result.first_frame, frames,
-                                                             options.shape.silhouettes.source, &hulls);
-  const int reference = result.shape.reference_frame - result.first_frame;
-
-  // Motion initialization from the reference frame's fit, corrected towards every frame's.
-  start.Restart();
-  std::vector<geometry::Positions> fitted(frames);
-  for (int i = 0; i < frames; ++i) fitted[i] = result.shape.frames[i].control.at(finest);
-  result.motion = InitializeMotion(images, hierarchy, fitted, reference, options.motion, progress);
-  result.motion_seconds = start.Seconds();
-  result.control = result.motion.control;
-
-  if (options.refine) {
-    start.Restart();
-    result.refinement = RefineStereo(images, hierarchy, result.control, dataset.bounds(), options.refinement, progress);
-    result.control = result.refinement->control;
-    result.refinement_seconds = start.Seconds();
-    if (options.retrack) {
-      start.Restart();
-      result.retrack =
-          InitializeMotion(images, hierarchy, result.control, reference, options.RetrackOptions(), progress);
-      result.control = result.retrack->control;
-      result.retrack_seconds = start.Seconds();
-    }
+const char* StageName(Stage stage) {
+  switch (stage) {
+    case Stage::kShape: return "shape";
+    case Stage::kMotion: return "motion";
+    case Stage::kRefine: return "refine";
+    case Stage::kRetrack: return "retrack";
   }
+  return "?";
+}
 
-  result.split = SplitRigidMotion(hierarchy, result.control);
-  return result;
+std::vector<Stage> StagesOf(const ReconstructionOptions& options) {
+  std::vector<Stage> stages{Stage::kShape, Stage::kMotion};
+  if (options.refine) stages.push_back(Stage::kRefine);
+  if (options.refine && options.retrack) stages.push_back(Stage::kRetrack);
+  return stages;
+}
+
+void StageState::Check(const std::string& source) const {
+  if (!hierarchy) ThrowError(source, "hierarchy", "missing");
+  if (control.empty()) ThrowError(source, "control", "expected at least one frame");
+  if (hulls.size() != control.size())
+    ThrowError(source, "hull", "expected one per frame (" + std::to_string(control.size()) + "), found " +
+                                   std::to_string(hulls.size()));
+  const int vertices = hierarchy->VertexCount(hierarchy->finest_level());
+  for (int i = 0; i < frame_count(); ++i)
+    if (control[i].rows() != vertices || control[i].cols() != 3)
+      ThrowError(source, "control of frame " + std::to_string(first_frame + i),
+                 "expected " + std::to_string(vertices) + " × 3 control points of level " +
+                     std::to_string(hierarchy->finest_level()));
+  if (reference_index() < 0 || reference_index() >= frame_count())
+    ThrowError(source, "reference_frame",
+               std::to_string(reference_frame) + " is outside the frames [" + std::to_string(first_frame) + ", " +
+                   std::to_string(first_frame + frame_count()) + ")");
+}
+
+StageState StageState::Frames(int first, int count, const std::string& source) const {
+  if (count < 1 || first < first_frame || first + count > first_frame + frame_count())
+    ThrowError(source, "frames",
+               "[" + std::to_string(first) + ", " + std::to_string(first + count) + ") is not inside the frames [" +
+                   std::to_string(first_frame) + ", " + std::to_string(first_frame + frame_count()) + ")");
+  StageState range = *this;
+  range.first_frame = first;
+  range.reference_frame = std::clamp(reference_frame, first, first + count - 1);
+  const int offset = first - first_frame;
+  range.hulls.assign(hulls.begin() + offset, hulls.begin() + offset + count);
+  range.control.assign(control.begin() + offset, control.begin() + offset + count);
+  return range;
+}
+
+geometry::Positions StageState::Surface(int i) const {
+  return hierarchy->LimitPositions(hierarchy->finest_level()) * control.at(i);
+}
+
+vision::ImageSequence StageImages(const vision::Dataset& dataset, const StageState& state) {
+  return vision::DatasetImages(dataset, state.first_frame, state.frame_count(), state.evidence, &state.hulls);
+}
+
+StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions& options, Progress* progress,
+                         ShapeInitResult* figures) {
+  *figures = InitializeShape(dataset, options, progress);
+  StageState state;
+  state.hierarchy = figures->hierarchy;
+  state.base_mesh = figures->base_mesh;
+  state.first_frame = figures->frames.front().frame;
+  state.reference_frame = figures->reference_frame;
+  state.evidence = options.silhouettes.source;
+  const int finest = state.hierarchy->finest_level();
+  for (const FrameShapeInit& frame : figures->frames) {
+    state.hulls.push_back(frame.hull);
+    state.control.push_back(frame.control.at(finest));
+  }
+  return state;
+}
+
+StageState RunMotionStage(const vision::Dataset& dataset, const StageState& in, const MotionInitOptions& options,
+                          Progress* progress, MotionInitResult* figures) {
+  in.Check("motion stage input");
+  const vision::ImageSequence images = StageImages(dataset, in);
+  *figures = InitializeMotion(images, in.Hierarchy(), in.control, in.reference_index(), options, progress);
+  StageState out = in;
+  out.control = figures->control;
+  return out;
+}
+
+StageState RunRefineStage(const vision::Dataset& dataset, const StageState& in,
+                          const StereoRefinementOptions& options, Progress* progress, RefinementResult* figures) {
+  in.Check("refine stage input");
+  const vision::ImageSequence images = StageImages(dataset, in);
+  *figures = RefineStereo(images, in.Hierarchy(), in.control, dataset.bounds(), options, progress);
+  StageState out = in;
+  out.control = figures->control;
+  return out;
+}
+
+RigidSplit RunSplitStage(const StageState& in) {
+  in.Check("split stage input");
+  return SplitRigidMotion(in.Hierarchy(), in.control);
 }
 
 }  // namespace subflow::solver

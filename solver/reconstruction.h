@@ -1,11 +1,20 @@
-// The product's main job (method §4): shape initialization → motion initialization →
-// spatio-temporal stereo refinement → rigid / non-rigid split, on one LoopHierarchy for
-// the whole sequence. The result is the finest control points of every frame; the output
-// surface is their limit surface at the finest level's vertices (the same vertices and
-// faces at every frame, so each vertex is a trajectory).
+// The product's main job (method §4) as a chain of stages on one LoopHierarchy for the
+// whole sequence:
+//   shape    shape initialization (solver/shape/shape_init.h)
+//   motion   motion initialization by normal flow (solver/motion/motion_init.h)
+//   refine   spatio-temporal stereo refinement (solver/stereo/stereo_refinement.h)
+//   retrack  the motion pass again on the refined shapes
+//   split    rigid / non-rigid split of the final trajectories (solver/rigid/rigid_split.h)
+// Each stage is a function of the previous stage's StageState and its options struct.
+// `subflow reconstruct` runs them one after another in one process; `subflow shape`,
+// `motion`, `refine`, `retrack` and `split` run one each on the StageState the previous
+// one wrote to its stage folder (output/stage_folder.h, docs/stages.md): the same
+// functions, so both give the same result. The output surface is the limit surface of the
+// finest control points at the finest level's vertices (the same vertices and faces at
+// every frame, so each vertex is a trajectory).
 #pragma once
 
-#include <optional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,6 +25,7 @@
 #include "solver/shape/shape_init.h"
 #include "solver/stereo/stereo_refinement.h"
 #include "vision/dataset.h"
+#include "vision/image_sequence.h"
 
 namespace subflow::solver {
 
@@ -39,26 +49,56 @@ struct ReconstructionOptions {
   MotionInitOptions RetrackOptions() const;
 };
 
-struct ReconstructionResult {
-  ShapeInitResult shape;
-  MotionInitResult motion;
-  std::optional<RefinementResult> refinement;
-  std::optional<MotionInitResult> retrack;  // the second motion pass, when run
-  int first_frame = 0;
-  std::vector<geometry::Positions> control;  // final finest control points per frame
-  RigidSplit split;                          // their multires analysis and rigid motions
-  double shape_seconds = 0, motion_seconds = 0, refinement_seconds = 0, retrack_seconds = 0;
+// The stages that hand a StageState on, in the order Reconstruct runs them.
+enum class Stage { kShape, kMotion, kRefine, kRetrack };
+// "shape", "motion", "refine", "retrack": the subcommands and stage folder names.
+const char* StageName(Stage stage);
+// The stages `options` runs: shape, motion, then refine (unless refine is off) and retrack
+// (when refining and retrack is on).
+std::vector<Stage> StagesOf(const ReconstructionOptions& options);
 
-  // The stages' brief reports, one line each.
-  std::string BriefReport() const;
+// What one stage hands to the next, and all that its stage folder holds.
+struct StageState {
+  std::shared_ptr<const geometry::LoopHierarchy> hierarchy;
+  geometry::TriangleMesh base_mesh;  // T0: the hierarchy's base faces (positions: the reference hull's)
+  int first_frame = 0;               // dataset frame of index 0
+  int reference_frame = 0;           // dataset frame the motion passes propagate from
+  // The silhouettes' source shape initialization used (kAuto resolved per camera by
+  // vision::DatasetImages, as shape initialization did).
+  vision::EvidenceSource evidence = vision::EvidenceSource::kAuto;
+  std::vector<geometry::TriangleMesh> hulls;  // per frame: the visual hull (silhouettes of cameras without masks)
+  std::vector<geometry::Positions> control;   // per frame: the finest control points #V(n)×3
 
-  const geometry::LoopHierarchy& hierarchy() const { return *shape.hierarchy; }
-  // The output surface of frame i (0-based within the processed frames): the limit
-  // positions of the finest level's vertices.
+  int frame_count() const { return static_cast<int>(control.size()); }
+  int reference_index() const { return reference_frame - first_frame; }
+  const geometry::LoopHierarchy& Hierarchy() const { return *hierarchy; }
+  // Throws subflow::Error naming `source` when the sizes disagree (hulls and control per
+  // frame, control rows against the hierarchy's finest level, the reference frame outside).
+  void Check(const std::string& source) const;
+  // Dataset frames [first, first + count) of this state (a range of frames or a refinement
+  // window run alone); the reference frame moves to the frame of the range nearest to it.
+  // Throws subflow::Error naming `source` when the range is not inside the state's frames.
+  StageState Frames(int first, int count, const std::string& source) const;
+  // The output surface of index i: the limit positions of the finest level's vertices.
   geometry::Positions Surface(int i) const;
 };
 
-ReconstructionResult Reconstruct(const vision::Dataset& dataset, const ReconstructionOptions& options,
-                                 Progress* progress = nullptr);
+// Images of the state's frames as the motion and refinement stages read them (gray images
+// and silhouettes: masks where the evidence is masks, else the projected hulls). `dataset`
+// and `state` must outlive the sequence.
+vision::ImageSequence StageImages(const vision::Dataset& dataset, const StageState& state);
+
+// The stages. Each returns the state the next one reads and keeps its figures in
+// *figures (for report.json).
+StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions& options, Progress* progress,
+                         ShapeInitResult* figures);
+// Motion initialization from the reference frame's control points, each frame corrected
+// towards its own (the shape stage's fit, or, for the retrack pass, the refined shapes).
+StageState RunMotionStage(const vision::Dataset& dataset, const StageState& in, const MotionInitOptions& options,
+                          Progress* progress, MotionInitResult* figures);
+StageState RunRefineStage(const vision::Dataset& dataset, const StageState& in,
+                          const StereoRefinementOptions& options, Progress* progress, RefinementResult* figures);
+// The rigid / non-rigid split of the state's trajectories.
+RigidSplit RunSplitStage(const StageState& in);
 
 }  // namespace subflow::solver

@@ -60,6 +60,22 @@ const fs::path& TinyResult() {
   return directory;
 }
 
+// The stage folder `stage` (motion or refine) run on TinyResult (a shape stage folder).
+const fs::path& TinyStage(const std::string& stage) {
+  static std::map<std::string, fs::path> folders;
+  if (!folders.count(stage)) {
+    const fs::path from = stage == "motion" ? TinyResult() : TinyStage("motion");
+    const fs::path out = Scratch().FreshPath("stage_" + stage);
+    const test::CommandResult run = test::RunSubflow(
+        stage + " " + Quoted(TinyDataset()) + " --from " + Quoted(from) + " --out " + Quoted(out) +
+            (stage == "refine" ? " --iterations 1" : ""),
+        Scratch().path());
+    EXPECT_EQ(run.exit_code, 0) << run.output();
+    folders[stage] = out;
+  }
+  return folders.at(stage);
+}
+
 const fs::path& Tetrahedron() {
   static const fs::path path = [] {
     const fs::path file = Scratch() / "tetrahedron.ply";
@@ -92,6 +108,24 @@ const std::map<std::string, const WritingCommand*>& Commands() {
   static const WritingCommand hull{
       true, [](const fs::path& out) { return "hull " + Quoted(TinyDataset()) + " --out " + Quoted(out) + HullOptions(); },
       true};
+  static const WritingCommand shape{
+      true, [](const fs::path& out) { return "shape " + Quoted(TinyDataset()) + " --out " + Quoted(out) + HullOptions(); },
+      false};
+  // The stages after shape, each on the folder of the stage before it.
+  const auto stage_command = [](const std::string& stage, const std::string& from) {
+    return [stage, from](const fs::path& out) {
+      const fs::path input = from == "shape" ? TinyResult() : TinyStage(from);
+      return stage + " " + Quoted(TinyDataset()) + " --from " + Quoted(input) + " --out " + Quoted(out) +
+             (stage == "refine" ? " --iterations 1" : "");
+    };
+  };
+  static const WritingCommand motion{true, stage_command("motion", "shape"), true};
+  static const WritingCommand refine{true, stage_command("refine", "motion"), false};
+  static const WritingCommand retrack{true, stage_command("retrack", "refine"), false};
+  static const WritingCommand split{true, stage_command("split", "motion"), true};
+  static const WritingCommand merge{
+      true, [](const fs::path& out) { return "merge " + Quoted(TinyStage("motion")) + " --out " + Quoted(out); },
+      true};
   static const WritingCommand reconstruct{
       true, [](const fs::path& out) { return "reconstruct " + Quoted(TinyDataset()) + " --out " + Quoted(out) + HullOptions(); },
       false};
@@ -116,6 +150,8 @@ const std::map<std::string, const WritingCommand*>& Commands() {
   static const std::map<std::string, const WritingCommand*> commands = {
       {"check", nullptr},  // prints its figures (text or --json) on stdout only
       {"subdivide", &subdivide}, {"eval", &eval}, {"synth", &synth}, {"hull", &hull},
+      {"shape", &shape}, {"motion", &motion}, {"refine", &refine}, {"retrack", &retrack}, {"split", &split},
+      {"merge", &merge},
       {"reconstruct", &reconstruct}, {"export", &export_glb}, {"import", &import_qualisys}, {"render", &render},
       {"view", &view}};
   return commands;

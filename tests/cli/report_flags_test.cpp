@@ -64,6 +64,7 @@ struct Recorded {
 std::map<std::string, Recorded> ReconstructFlags() {
   return {
       {"--overwrite", {"", "/overwrite", true}},
+      {"--resume", {"", "/resume", true}},
       {"--no-refine", {"", "/options/refine", false}},
       {"--no-retrack", {"", "/options/retrack", false}},
       {"--retrack-weight", {"0.3", "/options/retrack_weight", 0.3}},

@@ -111,6 +111,22 @@ TEST_F(MeshIo, AsciiPlyRoundTripKeepsFloatValuesAndPropertiesExactly) {
   ExpectFloatRoundTrip(mesh, properties, read, read_properties);
 }
 
+TEST_F(MeshIo, DoublePlyRoundTripKeepsDoublesAndPropertiesExactly) {
+  // The stage folders (docs/stages.md) hand exact doubles from one stage to the next.
+  const TriangleMesh mesh = PerturbedOctahedron();
+  const VertexProperties properties = FlowProperties(mesh.vertex_count());
+  WriteMesh(Path("m.ply"), mesh, &properties, PlyFormat::kBinaryLittleEndianDouble);
+  EXPECT_NE(ReadBytes(Path("m.ply")).find("property double x\n"), std::string::npos);
+  VertexProperties read_properties;
+  const TriangleMesh read = ReadMesh(Path("m.ply"), {}, &read_properties);
+  EXPECT_EQ(read.V, mesh.V);
+  EXPECT_EQ(read.F, mesh.F);
+  for (const auto& [name, values] : properties.values) EXPECT_EQ(read_properties.values.at(name), values) << name;
+  // The float format would not have kept them.
+  WriteMesh(Path("f.ply"), mesh, &properties);
+  EXPECT_NE(ReadMesh(Path("f.ply")).V, mesh.V);
+}
+
 TEST_F(MeshIo, ObjRoundTripKeepsDoublesExactly) {
   // OBJ is text with 17 significant digits: every double comes back bit for bit.
   const TriangleMesh mesh = PerturbedOctahedron();

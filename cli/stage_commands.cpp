@@ -1,0 +1,178 @@
+// The stages of `subflow reconstruct` as commands on stage folders (docs/stages.md):
+//   subflow shape   DATASET --out S [--frames A:B] [shape options]     (also: hull)
+//   subflow motion  DATASET --from S --out M [--frames A:B] [motion options]
+//   subflow refine  DATASET --from M --out R [--frames A:B] [refinement options]
+//   subflow retrack DATASET --from R --out T [--frames A:B] [motion options, --retrack-weight]
+//   subflow split   DATASET --from T --out RESULT                      (the OUTPUT.md result)
+//   subflow merge   FOLDER... --out DIR     (stage folders of frame ranges → one)
+// Each runs output::RunStage, as reconstruct does.
+#include <memory>
+#include <optional>
+
+#include <spdlog/spdlog.h>
+
+#include "cli/commands.h"
+#include "cli/progress_bar.h"
+#include "cli/stage_options.h"
+#include "core/stopwatch.h"
+#include "output/result_writer.h"
+#include "output/stage_pipeline.h"
+#include "vision/dataset.h"
+
+namespace subflow::cli {
+namespace {
+
+struct StageArguments {
+  std::string dataset;
+  std::string from;  // the previous stage's folder (not for shape)
+  std::string out;
+  bool overwrite = false;
+  std::string evidence = "auto";
+  int first_frame = 0, frame_count = -1;  // --frames of the input (not for shape)
+  solver::ReconstructionOptions options;
+};
+
+// The stage whose folder `stage` reads.
+solver::Stage InputStage(solver::Stage stage) {
+  switch (stage) {
+    case solver::Stage::kMotion: return solver::Stage::kShape;
+    case solver::Stage::kRefine: return solver::Stage::kMotion;
+    default: return solver::Stage::kRefine;
+  }
+}
+
+// Checks the options `stage` runs with (before any input is read).
+void CheckStageOptions(solver::Stage stage, const solver::ReconstructionOptions& options) {
+  switch (stage) {
+    case solver::Stage::kShape: return options.shape.Check();
+    case solver::Stage::kMotion: return options.motion.Check();
+    case solver::Stage::kRefine: return options.refinement.Check();
+    case solver::Stage::kRetrack: return options.Check();
+  }
+}
+
+void RunStageCommand(solver::Stage stage, const std::string& name, const StageArguments& arguments) {
+  solver::ReconstructionOptions options = arguments.options;
+  options.shape.silhouettes.source = vision::ParseEvidenceSource(arguments.evidence, "--evidence");
+  CheckStageOptions(stage, options);
+  const vision::Dataset dataset(arguments.dataset);
+  std::optional<output::StageRecord> in;
+  if (stage != solver::Stage::kShape) {
+    in = output::ReadStageFolder(arguments.from, solver::StageName(InputStage(stage)));
+    if (arguments.frame_count > 0)
+      in->state = in->state.Frames(arguments.first_frame, arguments.frame_count, arguments.from);
+  }
+  output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  ProgressBar progress;
+  output::RunStage(stage, {name, arguments.out, arguments.overwrite}, dataset, options, in ? &*in : nullptr,
+                   arguments.out, &progress);
+  spdlog::info("{}: stage folder written to {}", name, arguments.out);
+}
+
+// `name`: the subcommand, StageName(stage) or an alias (hull).
+Command AddStageCommand(CLI::App& app, solver::Stage stage, const std::string& name, const std::string& description) {
+  auto arguments = std::make_shared<StageArguments>();
+  CLI::App* sub = app.add_subcommand(name, description);
+  AddDatasetAndOutput(sub, &arguments->dataset, &arguments->out, &arguments->overwrite);
+  if (stage != solver::Stage::kShape) {
+    sub->add_option("--from", arguments->from, "Stage folder of the previous stage")
+        ->required()->check(CLI::ExistingDirectory);
+    AddFramesOption(sub, &arguments->first_frame, &arguments->frame_count, false);
+  }
+  switch (stage) {
+    case solver::Stage::kShape:
+      AddShapeInitOptions(sub, &arguments->options.shape, &arguments->evidence);
+      break;
+    case solver::Stage::kRetrack:
+      sub->add_option("--retrack-weight", arguments->options.retrack_weight,
+                      "Blend of the motion pass towards each frame's refined surface (0..1)")
+          ->capture_default_str();
+      [[fallthrough]];
+    case solver::Stage::kMotion:
+      AddMotionInitOptions(sub, &arguments->options.motion);
+      break;
+    case solver::Stage::kRefine:
+      AddRefinementOptions(sub, &arguments->options.refinement);
+      break;
+  }
+  return {sub, [stage, name, arguments] { RunStageCommand(stage, name, *arguments); }};
+}
+
+struct SplitArguments {
+  std::string dataset, from, out;
+  bool overwrite = false;
+};
+
+void RunSplit(const SplitArguments& arguments) {
+  const Stopwatch start;
+  const vision::Dataset dataset(arguments.dataset);
+  const output::StageRecord last = output::ReadStageFolder(arguments.from);
+  output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  nlohmann::json stages = nlohmann::json::object();
+  for (const auto& [section, ignored] : last.report.value("options", nlohmann::json::object()).items())
+    stages[section] = "loaded";
+  output::WriteReconstruction({"split", arguments.out, arguments.overwrite}, dataset,
+                              last.report.value("options", nlohmann::json::object()), last, stages, start);
+  spdlog::info("split: {} frames written to {} in {:.1f} s", last.state.frame_count(), arguments.out,
+               start.Seconds());
+}
+
+struct MergeArguments {
+  std::vector<std::string> inputs;
+  std::string out;
+  bool overwrite = false;
+};
+
+void RunMerge(const MergeArguments& arguments) {
+  output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  const output::StageRecord merged =
+      output::MergeStageFolders({"merge", arguments.out, arguments.overwrite}, arguments.inputs, arguments.out);
+  spdlog::info("merge: {} stage folders, frames {}–{}, written to {}", arguments.inputs.size(),
+               merged.state.first_frame, merged.state.first_frame + merged.state.frame_count() - 1, arguments.out);
+}
+
+}  // namespace
+
+Command AddShapeCommand(CLI::App& app) {
+  return AddStageCommand(app, solver::Stage::kShape, "shape",
+                         "Shape initialization (method §4.1): visual hull per frame, base mesh, and a subdivision "
+                         "surface fitted to every frame on one connectivity; writes a stage folder");
+}
+Command AddHullCommand(CLI::App& app) {
+  return AddStageCommand(app, solver::Stage::kShape, "hull", "The shape stage under its earlier name (= shape)");
+}
+Command AddMotionCommand(CLI::App& app) {
+  return AddStageCommand(app, solver::Stage::kMotion, "motion",
+                         "Motion initialization (§4.2) on a shape stage folder: trajectories by normal flow");
+}
+Command AddRefineCommand(CLI::App& app) {
+  return AddStageCommand(app, solver::Stage::kRefine, "refine",
+                         "Spatio-temporal stereo refinement (§4.3) on a motion stage folder");
+}
+Command AddRetrackCommand(CLI::App& app) {
+  return AddStageCommand(app, solver::Stage::kRetrack, "retrack",
+                         "The motion pass again, on a refine stage folder's refined shapes");
+}
+
+Command AddSplitCommand(CLI::App& app) {
+  auto arguments = std::make_shared<SplitArguments>();
+  CLI::App* sub = app.add_subcommand(
+      "split", "Rigid / non-rigid split (§5) of a stage folder's trajectories; writes the result (OUTPUT.md)");
+  AddDatasetAndOutput(sub, &arguments->dataset, &arguments->out, &arguments->overwrite);
+  sub->add_option("--from", arguments->from, "Stage folder of the last stage run (retrack, refine or motion)")
+      ->required()->check(CLI::ExistingDirectory);
+  return {sub, [arguments] { RunSplit(*arguments); }};
+}
+
+Command AddMergeCommand(CLI::App& app) {
+  auto arguments = std::make_shared<MergeArguments>();
+  CLI::App* sub = app.add_subcommand(
+      "merge", "Stage folders of one stage over ranges of frames (--frames) → one stage folder over all of them");
+  sub->add_option("FOLDERS", arguments->inputs, "Stage folders, one per range")
+      ->required()->check(CLI::ExistingDirectory);
+  sub->add_option("--out", arguments->out, "Output stage folder (must be new or empty)")->required();
+  sub->add_flag("--overwrite", arguments->overwrite, "Write into a non-empty output directory");
+  return {sub, [arguments] { RunMerge(*arguments); }};
+}
+
+}  // namespace subflow::cli

@@ -1,0 +1,50 @@
+// A stage folder (docs/stages.md, layout version kStageLayoutVersion): what one stage of
+// the pipeline (solver/reconstruction.h) hands to the next, on disk.
+//   <folder>/base_mesh.ply                  T0, whose faces are the hierarchy's level 0
+//   <folder>/hull/<frame>.ply               each frame's visual hull (silhouettes of the
+//                                           cameras without masks)
+//   <folder>/control/<frame>/level_<i>.ply  the frame's control points: every level for the
+//                                           shape stage, the finest level for the others
+//   <folder>/meshes/<frame>.ply             (shape stage) the fitted limit surfaces, OUTPUT.md
+//   <folder>/report.json                    written last: stage_layout_version, stage,
+//                                           frames, reference_frame, levels, evidence, the
+//                                           options and figures of every stage so far
+// The PLY files a later stage reads hold doubles, so a stage run from the folder sees
+// exactly the values the previous stage computed. Every file is written to a temporary
+// name and renamed, and report.json comes last: a folder without it is unfinished, and
+// reading it says so.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "solver/reconstruction.h"
+
+namespace subflow::output {
+
+inline constexpr int kStageLayoutVersion = 1;
+
+// A stage's state with its report.json.
+struct StageRecord {
+  solver::StageState state;
+  nlohmann::json report;
+};
+
+// Writes `record` into `folder` (created; a previous stage's report.json there is removed
+// first, its other files replaced), adding the layout fields to the report. `all_levels`
+// (the shape stage): per frame, the control points of levels 0..n, also written as
+// meshes/ (the fitted limit surfaces); otherwise the finest level only.
+void WriteStageFolder(const std::string& folder, const StageRecord& record,
+                      const std::vector<std::vector<geometry::Positions>>* all_levels = nullptr);
+
+// True when `folder`/report.json exists: the stage that wrote the folder finished.
+bool StageFolderComplete(const std::string& folder);
+
+// Reads a complete stage folder. Throws subflow::Error naming the file: no report.json
+// ("unfinished"), another layout version, a stage other than `expected_stage` (when not
+// empty), a missing frame file, control points of the wrong count.
+StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage = "");
+
+}  // namespace subflow::output

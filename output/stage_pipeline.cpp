@@ -1,0 +1,190 @@
+#include "output/stage_pipeline.h"
+
+#include <filesystem>
+
+#include <spdlog/spdlog.h>
+
+#include "core/error.h"
+#include "core/json_reader.h"
+#include "output/options_json.h"
+#include "output/result_files.h"
+#include "output/result_writer.h"
+#include "output/sequence_writer.h"
+
+namespace subflow::output {
+
+namespace fs = std::filesystem;
+using solver::Stage;
+
+namespace {
+
+constexpr Stage kStages[] = {Stage::kShape, Stage::kMotion, Stage::kRefine, Stage::kRetrack};
+
+nlohmann::json OptionsOf(const solver::ReconstructionOptions& options, Stage stage) {
+  switch (stage) {
+    case Stage::kShape: return options.shape;
+    case Stage::kMotion: return options.motion;
+    case Stage::kRefine: return options.refinement;
+    case Stage::kRetrack: return options.RetrackOptions();
+  }
+  return nullptr;
+}
+
+// Runs the solver stage and returns its state; *section gets its figures for the report.
+solver::StageState RunSolverStage(Stage stage, const vision::Dataset& dataset,
+                                  const solver::ReconstructionOptions& options, const StageRecord* in,
+                                  Progress* progress, nlohmann::json* section, std::string* brief,
+                                  std::vector<std::vector<geometry::Positions>>* all_levels) {
+  if (stage == Stage::kShape) {
+    solver::ShapeInitResult figures;
+    solver::StageState state = solver::RunShapeStage(dataset, options.shape, progress, &figures);
+    *section = ShapeInitJson(dataset, options.shape, figures);
+    *brief = figures.BriefReport();
+    for (const solver::FrameShapeInit& frame : figures.frames) all_levels->push_back(frame.control);
+    return state;
+  }
+  if (!in) ThrowError(StageName(stage), "input", "the stage needs the folder of the stage before it");
+  if (stage == Stage::kRefine) {
+    solver::RefinementResult figures;
+    solver::StageState state = solver::RunRefineStage(dataset, in->state, options.refinement, progress, &figures);
+    *section = RefinementJson(options.refinement, figures, state.first_frame);
+    *brief = figures.BriefReport();
+    return state;
+  }
+  const solver::MotionInitOptions motion = stage == Stage::kMotion ? options.motion : options.RetrackOptions();
+  solver::MotionInitResult figures;
+  solver::StageState state = solver::RunMotionStage(dataset, in->state, motion, progress, &figures);
+  *section = MotionInitJson(motion, figures, state.first_frame);
+  *brief = (stage == Stage::kRetrack ? "retrack: " : "") + figures.BriefReport();
+  return state;
+}
+
+}  // namespace
+
+const char* StageSection(Stage stage) {
+  switch (stage) {
+    case Stage::kShape: return "shape_init";
+    case Stage::kMotion: return "motion_init";
+    case Stage::kRefine: return "refinement";
+    case Stage::kRetrack: return "retrack";
+  }
+  return "?";
+}
+
+Stage StageNamed(const std::string& name, const std::string& source) {
+  for (Stage stage : kStages)
+    if (name == StageName(stage)) return stage;
+  ThrowError(source, "stage", "\"" + name + "\" is not one of shape, motion, refine, retrack");
+}
+
+nlohmann::json StageOptionsJson(const solver::ReconstructionOptions& options, Stage last) {
+  nlohmann::json json = nlohmann::json::object();
+  for (Stage stage : solver::StagesOf(options)) {
+    json[StageSection(stage)] = OptionsOf(options, stage);
+    if (stage == last) break;
+  }
+  return json;
+}
+
+StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& dataset,
+                     const solver::ReconstructionOptions& options, const StageRecord* in, const std::string& folder,
+                     Progress* progress) {
+  const Stopwatch start;
+  StageRecord record;
+  nlohmann::json section;
+  std::string brief;
+  std::vector<std::vector<geometry::Positions>> all_levels;
+  record.state = RunSolverStage(stage, dataset, options, in, progress, &section, &brief, &all_levels);
+  const double seconds = start.Seconds();
+  spdlog::info("{}", brief);
+
+  nlohmann::json& report = record.report;
+  report = ReportHead(run, dataset);
+  report["stage"] = StageName(stage);
+  report["options"] = nlohmann::json::object();
+  report["timings_seconds"] = nlohmann::json::object();
+  if (in) {  // what the stages before this one ran with and found
+    for (const char* key : {"options", "timings_seconds"})
+      if (in->report.contains(key)) report[key] = in->report[key];
+    for (Stage before : kStages)
+      if (in->report.contains(StageSection(before))) report[StageSection(before)] = in->report[StageSection(before)];
+  }
+  report["options"][StageSection(stage)] = OptionsOf(options, stage);
+  report[StageSection(stage)] = section;
+  report["timings_seconds"][StageSection(stage)] = seconds;
+  WriteStageFolder(folder, record, all_levels.empty() ? nullptr : &all_levels);
+  return record;
+}
+
+void WriteReconstruction(const CommandRun& run, const vision::Dataset& dataset, const nlohmann::json& options_json,
+                         const StageRecord& last, const nlohmann::json& stages, const Stopwatch& since_start) {
+  const solver::StageState& state = last.state;
+  const Stopwatch split_start;
+  const solver::RigidSplit split = solver::RunSplitStage(state);
+  const double split_seconds = split_start.Seconds();
+  const Stopwatch write_start;
+  nlohmann::json report = ReportHead(run, dataset);
+  report["options"] = options_json;
+  report["stages"] = stages;
+  for (Stage stage : kStages)
+    if (last.report.contains(StageSection(stage))) report[StageSection(stage)] = last.report[StageSection(stage)];
+  report["rigid_motion"] = RigidMotionJson(split.rigid, state.first_frame);
+  report["flow"] = WriteSequence(run.out, state.Hierarchy(), state.first_frame, state.control, split);
+  WriteHullFiles(run.out, state.base_mesh, state.first_frame, state.hulls);
+  nlohmann::json timings = last.report.value("timings_seconds", nlohmann::json::object());
+  timings["rigid_split"] = split_seconds;
+  timings["writing"] = write_start.Seconds();
+  timings["total"] = since_start.Seconds();
+  report["timings_seconds"] = timings;
+  report["total_seconds"] = timings["total"];
+  WriteJsonFile((fs::path(run.out) / "report.json").string(), report);
+  spdlog::info("{}", split.BriefReport());
+}
+
+std::string StageFolderOf(const std::string& out, Stage stage) {
+  return (fs::path(out) / "stages" / StageName(stage)).string();
+}
+
+namespace {
+
+// Whether the complete stage folder `folder` was written by `stage` for this dataset, these
+// options and, after the shape stage, the frames of `in`.
+bool StageMatches(const std::string& folder, Stage stage, const vision::Dataset& dataset,
+                  const solver::ReconstructionOptions& options, const StageRecord* in) {
+  if (!StageFolderComplete(folder)) return false;
+  const nlohmann::json report =
+      ReadJsonFile((fs::path(folder) / "report.json").string(), "a stage report (docs/stages.md)");
+  const bool same_frames =
+      !in || report.value("frames", nlohmann::json()) ==
+                 nlohmann::json{{"first", in->state.first_frame}, {"count", in->state.frame_count()}};
+  return report.value("stage_layout_version", -1) == kStageLayoutVersion &&
+         report.value("stage", "") == StageName(stage) && same_frames &&
+         report.value("options", nlohmann::json()) == StageOptionsJson(options, stage) && report.contains("dataset") &&
+         report["dataset"].value("directory", "") == DatasetJson(dataset)["directory"];
+}
+
+}  // namespace
+
+nlohmann::json RunReconstruction(const CommandRun& run, const vision::Dataset& dataset,
+                                 const solver::ReconstructionOptions& options, bool resume, Progress* progress,
+                                 const Stopwatch& since_start) {
+  std::optional<StageRecord> last;
+  nlohmann::json stages = nlohmann::json::object();
+  bool reuse = resume;
+  for (Stage stage : solver::StagesOf(options)) {
+    const std::string folder = StageFolderOf(run.out, stage);
+    const StageRecord* in = last ? &*last : nullptr;
+    reuse = reuse && StageMatches(folder, stage, dataset, options, in);
+    if (reuse) {
+      last = ReadStageFolder(folder, StageName(stage));
+      spdlog::info("{}: loaded from {} (--resume)", StageName(stage), folder);
+    } else {
+      last = RunStage(stage, run, dataset, options, in, folder, progress);
+    }
+    stages[StageName(stage)] = reuse ? "loaded" : "computed";
+  }
+  WriteReconstruction(run, dataset, options, *last, stages, since_start);
+  return stages;
+}
+
+}  // namespace subflow::output
