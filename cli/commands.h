@@ -57,7 +57,10 @@ inline std::vector<AddCommandFunction> AllCommands() {
 }
 
 // Runs the command whose subcommand was parsed. A subflow::Error is printed in one line
-// ("subflow <command>: error: ...") and gives exit code 1; success gives 0.
+// ("subflow <command>: error: ...") and gives exit code 1; success gives 0. SIGINT and
+// SIGTERM stop the work at its next progress point (core/interrupt.h): "subflow
+// <command>: interrupted: <signal> (finished: <stages>...)", exit code 128 + signal
+// (130, 143), no report.json.
 int RunSelected(const std::vector<Command>& commands, bool verbose);
 
 }  // namespace subflow::cli

@@ -1,6 +1,5 @@
 // `subflow eval DATASET RESULT`: scores a reconstruction (../shared/OUTPUT.md) against the
 // dataset's ground truth (vision/evaluation.h); prints a table, optionally writes JSON.
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -17,6 +16,7 @@
 #include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "output/overwrite_guard.h"
+#include "output/result_writer.h"
 #include "solver/rigid/rigid_motion.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
@@ -100,17 +100,9 @@ void RunEval(const EvalSettings& settings) {
   }
   std::cout.flush();
   if (!settings.json_path.empty()) {
-    const std::string temporary = settings.json_path + ".tmp";
-    {
-      std::ofstream file(temporary);
-      if (!file) ThrowError(settings.json_path, "", "cannot write");
-      nlohmann::json json = nlohmann::json::parse(report.Json());
-      json["rigid_motion"] = rigid;
-      file << json.dump(2) << "\n";
-      if (!file) ThrowError(settings.json_path, "", "cannot write");
-    }
-    if (std::rename(temporary.c_str(), settings.json_path.c_str()) != 0)
-      ThrowError(settings.json_path, "", "cannot write (rename failed)");
+    nlohmann::json json = nlohmann::json::parse(report.Json());
+    json["rigid_motion"] = rigid;
+    output::WriteJsonFile(settings.json_path, json);
   }
 }
 

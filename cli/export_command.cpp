@@ -20,7 +20,7 @@
 #include "core/stopwatch.h"
 #include "geometry/mesh_io.h"
 #include "output/glb_writer.h"
-#include "output/output_file.h"
+#include "output/overwrite_guard.h"
 #include "output/point_cache.h"
 #include "output/result_metadata.h"
 #include "output/result_reader.h"
@@ -80,8 +80,8 @@ void RunExport(const ExportArguments& arguments) {
   const output::ResultReader result(arguments.result);
   const output::ResultMetadata metadata =
       output::ResolveResultMetadata(result, arguments.dataset, arguments.fps);
-  if (!sequence) output::CheckOutputPath(arguments.out, arguments.overwrite);
-  if (format == "pc2" || format == "mdd") output::CheckOutputPath(BaseObjPath(arguments.out), arguments.overwrite);
+  if (!sequence) output::CheckOutputFile(arguments.out, arguments.overwrite, "");
+  if (format == "pc2" || format == "mdd") output::CheckOutputFile(BaseObjPath(arguments.out), arguments.overwrite, "");
   if (metadata.fps_source == "default" && (format == "mdd" || format == "glb"))
     spdlog::warn("no frame rate in {}/report.json or its dataset's cameras.json: assuming {} fps (pass --fps)",
                  arguments.result, metadata.fps);
@@ -121,7 +121,7 @@ void RunExport(const ExportArguments& arguments) {
   const auto bytes = sequence ? 0 : fs::file_size(arguments.out, error);
   const std::string report_path =
       sequence ? (fs::path(arguments.out) / "report.json").string() : arguments.out + ".report.json";
-  if (!sequence) output::CheckOutputPath(report_path, true);
+  if (!sequence) output::CheckOutputFile(report_path, true, "");
   output::WriteJsonFile(report_path, {{"command", "export"},
                                       {"versions", output::VersionsJson()},
                                       {"result", arguments.result},

@@ -17,7 +17,6 @@
 #include "output/result_writer.h"
 #include <filesystem>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "vision/calibration_preview.h"
 #include "vision/dataset.h"
@@ -92,7 +91,7 @@ void WritePreviews(const vision::Dataset& dataset, const vision::Calibration& ca
   for (int c = 0; c < dataset.camera_count(); ++c) {
     const cv::Mat image = vision::DrawCalibrationPreview(dataset.camera(c), dataset.Image(c, 0), dataset.bounds(), preview);
     const std::string path = (folder / (dataset.camera(c).name() + ".png")).string();
-    if (!cv::imwrite(path, image)) ThrowError(path, "", "cannot write the preview (cv::imwrite failed)");
+    vision::WritePng(path, image);
   }
 }
 

@@ -9,6 +9,8 @@
 
 #include "cli/commands.h"
 #include "cli/progress_bar.h"
+#include "output/report.h"
+#include "output/result_writer.h"
 #include "vision/synthetic_render.h"
 
 namespace subflow::cli {
@@ -93,6 +95,21 @@ Command AddSynthCommand(CLI::App& app) {
             }
             ProgressBar progress;
             const vision::SynthSummary summary = vision::WriteSyntheticDataset(*out, *options, &progress);
+            // Last, so that a dataset folder without it is visibly unfinished.
+            output::WriteJsonFile(*out + "/report.json",
+                                  {{"command", "synth"},
+                                   {"versions", output::VersionsJson()},
+                                   {"scene", options->scene.scene},
+                                   {"rig", options->rig.rig},
+                                   {"cameras", summary.camera_count},
+                                   {"frames", summary.frame_count},
+                                   {"width", options->rig.width},
+                                   {"height", options->rig.height},
+                                   {"seed", options->seed},
+                                   {"mesh", {{"vertices", summary.vertex_count}, {"faces", summary.face_count}}},
+                                   {"bounds", {{"min", {summary.bounds.min.x(), summary.bounds.min.y(), summary.bounds.min.z()}},
+                                               {"max", {summary.bounds.max.x(), summary.bounds.max.y(), summary.bounds.max.z()}}}},
+                                   {"seconds", summary.seconds}});
             std::cout << "synth " << options->scene.scene << ": " << summary.camera_count << " cameras ("
                       << options->rig.rig << "), " << summary.frame_count << " frames, "
                       << options->rig.width << "x" << options->rig.height << ", mesh "

@@ -9,7 +9,7 @@
 #include "cli/progress_bar.h"
 #include "output/report.h"
 #include "core/stopwatch.h"
-#include "output/output_file.h"
+#include "output/overwrite_guard.h"
 #include "output/result_metadata.h"
 #include "output/result_reader.h"
 #include "output/result_writer.h"
@@ -33,7 +33,7 @@ void RunView(const ViewArguments& arguments) {
   const Stopwatch stopwatch;
   const output::ResultReader result(arguments.result);
   const output::ResultMetadata metadata = output::ResolveResultMetadata(result, arguments.dataset, arguments.fps);
-  output::CheckOutputPath(arguments.out, arguments.overwrite);
+  output::CheckOutputFile(arguments.out, arguments.overwrite, "");
   std::unique_ptr<vision::Dataset> dataset;
   if (!arguments.no_texture && !metadata.dataset_directory.empty())
     dataset = std::make_unique<vision::Dataset>(metadata.dataset_directory);

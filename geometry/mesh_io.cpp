@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "geometry/mesh_topology.h"
 #include "geometry/obj_io.h"
 #include "geometry/ply_io.h"
@@ -77,31 +79,15 @@ void WriteMesh(const std::string& path, const TriangleMesh& mesh,
     ThrowError(path, "vertex properties",
                "OBJ cannot store per-vertex properties (write a .ply instead)");
 
+  // Between two files of a sequence is a natural point to stop at (core/interrupt.h).
+  ThrowIfInterrupted();
   // Write beside the destination and rename, so a reader never sees a half-written mesh.
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out)
-      ThrowError(path, "",
-                 "cannot open \"" + temporary + "\" for writing: " + std::strerror(errno));
-    try {
-      if (kind == FileKind::kPly)
-        WritePly(out, mesh, properties, ply_format, path);
-      else
-        WriteObj(out, mesh, path);
-      out.flush();
-      if (!out) ThrowError(path, "", "write error (disk full?)");
-    } catch (...) {
-      out.close();
-      fs::remove(temporary, error);
-      throw;
-    }
-  }
-  fs::rename(temporary, path, error);
-  if (error) {
-    fs::remove(temporary, error);
-    ThrowError(path, "", "cannot rename \"" + temporary + "\" into place: " + error.message());
-  }
+  AtomicFile file(path);
+  if (kind == FileKind::kPly)
+    WritePly(file.stream(), mesh, properties, ply_format, path);
+  else
+    WriteObj(file.stream(), mesh, path);
+  file.Commit();
 }
 
 }  // namespace subflow::geometry

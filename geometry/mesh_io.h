@@ -42,6 +42,8 @@ enum class PlyFormat { kAscii, kBinaryLittleEndian, kBinaryLittleEndianDouble };
 // "uchar int" lists) or .obj, by extension. The directory must exist; OBJ cannot hold
 // properties (non-empty properties with a .obj path are an error); non-finite positions
 // and out-of-range indices are refused. Formats: geometry/ply_io.h, geometry/obj_io.h.
+// Written through core/atomic_file.h (".<name>.partial", renamed when complete); throws
+// subflow::Interrupted before starting once SIGINT / SIGTERM arrived (core/interrupt.h).
 void WriteMesh(const std::string& path, const TriangleMesh& mesh,
                const VertexProperties* properties = nullptr,
                PlyFormat ply_format = PlyFormat::kBinaryLittleEndian);

@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 #include "geometry/vertex_normals.h"
-#include "output/output_file.h"
+#include "core/atomic_file.h"
 #include "vision/dataset.h"
 
 namespace subflow::output {
@@ -276,7 +276,7 @@ GlbSummary WriteGlb(const ResultReader& result, const std::string& path, const G
   model.asset.version = "2.0";
   model.asset.generator = "subflow export";
 
-  OutputFile file(path);
+  AtomicFile file(path);
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToStream(&model, file.stream(), /*prettyPrint=*/false, /*writeBinary=*/true))
     ThrowError(path, "", "tinygltf could not write the glb");

@@ -5,7 +5,7 @@
 #include "core/error.h"
 #include "geometry/obj_io.h"
 #include "output/binary_stream.h"
-#include "output/output_file.h"
+#include "core/atomic_file.h"
 
 namespace subflow::output {
 namespace {
@@ -29,7 +29,7 @@ void WriteFramePositions(const ResultReader& result, std::ostream& out, ByteOrde
 
 void WritePc2(const ResultReader& result, const std::string& path, float start_frame,
               Progress* progress) {
-  OutputFile file(path);
+  AtomicFile file(path);
   std::ostream& out = file.stream();
   constexpr ByteOrder kOrder = ByteOrder::kLittleEndian;
   out.write("POINTCACHE2\0", 12);
@@ -45,7 +45,7 @@ void WritePc2(const ResultReader& result, const std::string& path, float start_f
 void WriteMdd(const ResultReader& result, const std::string& path, double fps, Progress* progress) {
   if (!(fps > 0.0) || !std::isfinite(fps))
     ThrowError(path, "fps", "expected a positive frame rate, got " + std::to_string(fps));
-  OutputFile file(path);
+  AtomicFile file(path);
   std::ostream& out = file.stream();
   constexpr ByteOrder kOrder = ByteOrder::kBigEndian;
   WriteInt32(out, result.frame_count(), kOrder);
@@ -56,7 +56,7 @@ void WriteMdd(const ResultReader& result, const std::string& path, double fps, P
 }
 
 void WriteBaseObj(const ResultReader& result, const std::string& path) {
-  OutputFile file(path);
+  AtomicFile file(path);
   const geometry::TriangleMesh first{result.ReadFrame(0).V, result.faces()};
   geometry::WriteObj(file.stream(), first, path);
   file.Commit();

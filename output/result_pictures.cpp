@@ -6,29 +6,20 @@
 #include <memory>
 #include <set>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "geometry/vertex_normals.h"
 #include "output/camera_texture.h"
 #include "output/flow_magnitude.h"
-#include "output/output_file.h"
+#include "vision/dataset_writer.h"
 
 namespace subflow::output {
 namespace {
 
 namespace fs = std::filesystem;
-
-void WritePng(const fs::path& path, const cv::Mat& picture) {
-  fs::create_directories(path.parent_path());
-  std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", picture, bytes)) ThrowError(path.string(), "", "OpenCV cannot encode the PNG");
-  OutputFile file(path.string());
-  file.stream().write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  file.Commit();
-}
 
 Eigen::MatrixX3f VertexColours(const Eigen::VectorXf& magnitudes, const ColourScale& scale) {
   Eigen::MatrixX3f colours(magnitudes.size(), 3);
@@ -63,7 +54,7 @@ class PictureWriter {
       written = WithColourBar(picture, *scale, &entry.bar);
       entry.has_bar = true;
     }
-    WritePng(fs::path(out_) / relative, written);
+    vision::WritePng((fs::path(out_) / relative).string(), written);
     summary_->pictures.push_back(entry);
   }
 
@@ -99,21 +90,22 @@ class Mp4Writers {
   void Write(const std::string& camera, const cv::Mat& picture) {
     cv::Mat even;  // codecs want even sizes
     cv::copyMakeBorder(picture, even, 0, picture.rows % 2, 0, picture.cols % 2, cv::BORDER_REPLICATE);
-    cv::VideoWriter& video = videos_[camera];
-    if (!video.isOpened()) {
+    Video& video = videos_[camera];
+    if (!video.writer.isOpened()) {
       fs::create_directories(directory_);
-      const fs::path partial = directory_ / (camera + ".partial.mp4");
-      video.open(partial.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps_, even.size());
-      if (!video.isOpened()) ThrowError(partial.string(), "", "OpenCV cannot write MP4 (mp4v) on this system");
+      video.file = std::make_unique<AtomicFile>((directory_ / (camera + ".mp4")).string(), AtomicFile::kKeepExtension);
+      video.writer.open(video.file->temporary(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps_, even.size());
+      if (!video.writer.isOpened())
+        ThrowError(video.file->path(), "", "OpenCV cannot write MP4 (mp4v) on this system");
     }
-    video.write(even);
+    video.writer.write(even);
   }
 
   // Closes and renames every video; adds them to `summary`.
   void Finish(int first_frame, RenderSummary* summary) {
     for (auto& [camera, video] : videos_) {
-      video.release();
-      fs::rename(directory_ / (camera + ".partial.mp4"), directory_ / (camera + ".mp4"));
+      video.writer.release();
+      video.file->Commit();
       summary->pictures.push_back({"mp4/" + camera + ".mp4", "mp4", first_frame, camera, 0, 0, {}, false});
     }
   }
@@ -121,7 +113,11 @@ class Mp4Writers {
  private:
   fs::path directory_;
   double fps_;
-  std::map<std::string, cv::VideoWriter> videos_;
+  struct Video {
+    std::unique_ptr<AtomicFile> file;  // the temporary is removed unless committed
+    cv::VideoWriter writer;
+  };
+  std::map<std::string, Video> videos_;
 };
 
 // What every picture of one frame shares.

@@ -1,8 +1,8 @@
 #include "output/result_writer.h"
 
 #include <filesystem>
-#include <fstream>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "geometry/mesh_io.h"
 #include "vision/dataset.h"
@@ -63,16 +63,7 @@ void WriteResultMeshes(const std::string& directory, int first_frame, const geom
 }
 
 void WriteJsonFile(const std::string& path, const nlohmann::json& json) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream stream(temporary);
-    if (!stream) ThrowError(path, "", "cannot open for writing");
-    stream << json.dump(2) << "\n";
-    if (!stream) ThrowError(path, "", "write failed");
-  }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) ThrowError(path, "", "cannot rename the temporary file: " + error.message());
+  WriteFileAtomically(path, json.dump(2) + "\n");
 }
 
 }  // namespace subflow::output

@@ -11,7 +11,7 @@
 #include "output/camera_texture.h"
 #include "output/colour_scale.h"
 #include "output/flow_magnitude.h"
-#include "output/output_file.h"
+#include "core/atomic_file.h"
 #include "output/view_cameras.h"
 #include "output/viewer_assets.h"
 
@@ -129,7 +129,7 @@ ViewerSummary WriteViewer(const ResultReader& result, const vision::Dataset* dat
     summary.colourings.push_back("texture");
   }
   const std::string page = Page(data);
-  OutputFile file(path);
+  AtomicFile file(path);
   file.stream().write(page.data(), static_cast<std::streamsize>(page.size()));
   file.Commit();
   summary.bytes = page.size();

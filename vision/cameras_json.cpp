@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "vision/dataset.h"
@@ -166,16 +167,7 @@ void WriteCamerasJson(const std::string& path, const std::vector<Camera>& camera
 
   // nlohmann::json prints doubles with the shortest representation that reads back to the
   // same double, so the round trip is exact.
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file) ThrowError(path, "", "cannot write (could not create " + temporary + ")");
-    file << root.dump(1) << "\n";
-    if (!file) ThrowError(path, "", "cannot write (write to " + temporary + " failed)");
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) ThrowError(path, "", "cannot write (rename from " + temporary + " failed: " + error.message() + ")");
+  WriteFileAtomically(path, root.dump(1) + "\n");
 }
 
 }  // namespace subflow::vision

@@ -1,10 +1,14 @@
 #include "vision/dataset_writer.h"
 
 #include <filesystem>
+#include <string_view>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "geometry/mesh_io.h"
 
 namespace subflow::vision {
@@ -20,23 +24,21 @@ void CreateDirectories(const fs::path& path) {
   if (error) ThrowError(path.string(), "", "cannot create directory: " + error.message());
 }
 
-// PNG written beside the target then renamed, so no half-written frame is ever left.
-void WritePng(const fs::path& path, const cv::Mat& image) {
-  CreateDirectories(path.parent_path());
-  const fs::path temporary = path.string() + ".tmp.png";
-  bool written = false;
-  try {
-    written = cv::imwrite(temporary.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 3});
-  } catch (const cv::Exception& e) {
-    ThrowError(path.string(), "", std::string("cannot write PNG: ") + e.what());
-  }
-  if (!written) ThrowError(path.string(), "", "cannot write PNG (cv::imwrite failed)");
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) ThrowError(path.string(), "", "cannot write (rename failed: " + error.message() + ")");
-}
-
 }  // namespace
+
+void WritePng(const std::string& path, const cv::Mat& image) {
+  ThrowIfInterrupted();  // between two files is a natural point to stop at (core/interrupt.h)
+  CreateDirectories(fs::path(path).parent_path());
+  std::vector<unsigned char> bytes;
+  bool encoded = false;
+  try {
+    encoded = cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 3});
+  } catch (const cv::Exception& e) {
+    ThrowError(path, "", std::string("cannot encode PNG: ") + e.what());
+  }
+  if (!encoded) ThrowError(path, "", "cannot encode PNG (cv::imencode failed)");
+  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+}
 
 void CheckDatasetDirectory(const std::string& directory, bool overwrite) {
   const fs::path root(directory);
@@ -93,7 +95,7 @@ void DatasetWriter::WriteImage(int camera, int frame, const cv::Mat& image) cons
   if (camera < 0 || camera >= static_cast<int>(cameras_.size())) CheckImage(camera, image, directory_);
   const fs::path path = fs::path(directory_) / "images" / cameras_[camera].name() / (FrameName(frame) + ".png");
   CheckImage(camera, image, path.string());
-  WritePng(path, image);
+  WritePng(path.string(), image);
 }
 
 void DatasetWriter::WriteMask(int camera, int frame, const cv::Mat& mask) const {
@@ -104,14 +106,14 @@ void DatasetWriter::WriteMask(int camera, int frame, const cv::Mat& mask) const 
   CheckImage(camera, mask, path.string());
   if (mask.type() != CV_8UC1) ThrowError(path.string(), "pixel type", "expected a CV_8UC1 mask");
   cv::Mat binary = mask != 0;
-  WritePng(path, binary);
+  WritePng(path.string(), binary);
 }
 
 void DatasetWriter::WriteBackground(int camera, const cv::Mat& image) const {
   if (camera < 0 || camera >= static_cast<int>(cameras_.size())) CheckImage(camera, image, directory_);
   const fs::path path = fs::path(directory_) / "background" / (cameras_[camera].name() + ".png");
   CheckImage(camera, image, path.string());
-  WritePng(path, image);
+  WritePng(path.string(), image);
 }
 
 void DatasetWriter::WriteGroundTruthMesh(int frame, const geometry::TriangleMesh& mesh) const {

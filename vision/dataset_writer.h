@@ -16,8 +16,13 @@
 
 namespace subflow::vision {
 
+// Writes `image` (8- or 16-bit, 1, 3 or 4 channels) as a PNG at `path`, creating its
+// directory, through core/atomic_file.h: no half-written PNG ever carries the name.
+// Throws subflow::Error naming the path when it cannot be encoded or written.
+void WritePng(const std::string& path, const cv::Mat& image);
+
 // Writes cameras.json (format "multiview-video/1"); absent optionals and an empty `units`
-// are left out. Writes "<path>.tmp" and renames. Throws subflow::Error naming the path
+// are left out, through core/atomic_file.h. Throws subflow::Error naming the path
 // when it cannot be written or a camera name is empty, duplicated or contains '/'.
 void WriteCamerasJson(const std::string& path, const std::vector<Camera>& cameras,
                       std::optional<double> fps, std::optional<int> frame_count,

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <optional>
 
@@ -11,6 +12,7 @@
 #include <opencv2/videoio.hpp>
 #include <tbb/parallel_for.h>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "geometry/vertex_normals.h"
 #include "vision/dataset_writer.h"
@@ -73,12 +75,11 @@ class VideoFiles {
     fs::create_directories(fs::path(directory) / "videos");
     for (const Camera& camera : cameras) {
       const fs::path final_path = fs::path(directory) / "videos" / (camera.name() + ".mp4");
-      const fs::path partial = fs::path(directory) / "videos" / (camera.name() + ".partial.mp4");
-      writers_.emplace_back(partial.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps,
+      files_.push_back(std::make_unique<AtomicFile>(final_path.string(), AtomicFile::kKeepExtension));
+      writers_.emplace_back(files_.back()->temporary(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps,
                             cv::Size(camera.width(), camera.height()), true);
       if (!writers_.back().isOpened())
-        ThrowError(partial.string(), "video", "OpenCV cannot write MP4 (mp4v) here");
-      paths_.push_back({partial.string(), final_path.string()});
+        ThrowError(final_path.string(), "video", "OpenCV cannot write MP4 (mp4v) here");
     }
   }
   void Write(int camera, const cv::Mat& image) {
@@ -90,7 +91,7 @@ class VideoFiles {
     namespace fs = std::filesystem;
     for (std::size_t c = 0; c < writers_.size(); ++c) {
       writers_[c].release();
-      fs::rename(paths_[c].first, paths_[c].second);
+      files_[c]->Commit();
     }
     // DatasetWriter made images/<cam>/ for PNG frames: a dataset has one source of frames.
     const fs::path images = fs::path(directory) / "images";
@@ -100,8 +101,8 @@ class VideoFiles {
   }
 
  private:
+  std::vector<std::unique_ptr<AtomicFile>> files_;  // removed unless committed
   std::vector<cv::VideoWriter> writers_;
-  std::vector<std::pair<std::string, std::string>> paths_;
 };
 
 }  // namespace

@@ -130,7 +130,7 @@ struct SynthSummary {
 
 // Renders `options` into a new dataset directory (DatasetWriter: refuses a non-empty
 // directory unless options.overwrite). Frame by frame, parallel over cameras (TBB);
-// videos are written to "<cam>.mp4.tmp.mp4" and renamed when complete.
+// every file goes through core/atomic_file.h (videos: ".<cam>.partial.mp4", renamed when complete).
 SynthSummary WriteSyntheticDataset(const std::string& directory, const SynthOptions& options,
                                    Progress* progress = nullptr);
 

@@ -141,7 +141,7 @@ TEST(ExportCommand, RefusesToOverwriteAndNamesBadInput) {
   EXPECT_EQ(not_result.exit_code, 1);
   EXPECT_NE(not_result.err.find("not a subflow result folder"), std::string::npos) << not_result.output();
   EXPECT_FALSE(fs::exists(Scratch() / "x.glb"));
-  EXPECT_FALSE(fs::exists(Scratch() / "x.glb.tmp"));
+  EXPECT_FALSE(fs::exists(Scratch() / ".x.glb.partial"));
 
   const test::CommandResult bad_up = RunSubflow(
       "export " + Quote(Result()) + " --format glb --up +w --out " + Quote(Scratch() / "y.glb"), Scratch().path());

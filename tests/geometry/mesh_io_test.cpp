@@ -98,7 +98,7 @@ TEST_F(MeshIo, BinaryPlyRoundTripKeepsFloatValuesAndPropertiesExactly) {
   VertexProperties read_properties;
   const TriangleMesh read = ReadMesh(Path("m.ply"), {}, &read_properties);
   ExpectFloatRoundTrip(mesh, properties, read, read_properties);
-  EXPECT_FALSE(fs::exists(Path("m.ply.tmp")));
+  EXPECT_FALSE(fs::exists(Path(".m.ply.partial")));
 }
 
 TEST_F(MeshIo, AsciiPlyRoundTripKeepsFloatValuesAndPropertiesExactly) {
@@ -394,7 +394,7 @@ TEST_F(MeshIo, WritersRefuseMissingDirectoriesAndBadPropertiesAndLeaveNoTemporar
     EXPECT_NE(std::string(e.what()).find("vertex property \"vx\""), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(Path("m.ply")));
-  EXPECT_FALSE(fs::exists(Path("m.ply.tmp")));
+  EXPECT_FALSE(fs::exists(Path(".m.ply.partial")));
   const VertexProperties flow = FlowProperties(mesh.vertex_count());
   EXPECT_THROW(WriteMesh(Path("m.obj"), mesh, &flow), Error);
   // Overwriting replaces the old file.
