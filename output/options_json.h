@@ -75,6 +75,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SilhouetteOptions, source, background_blur_si
                                    background_estimate_min_frames, background_estimate_margin, close_radius,
                                    fill_holes, min_region_pixels, min_object_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VoxelCarvingOptions, resolution, pixels_per_voxel, max_auto_resolution,
+                                   max_pixels_per_voxel,
                                    min_cameras, max_misses, evidence_threshold, footprint_margin, closing_radius,
                                    opening_radius, connectivity, min_component_fraction, fill_cavities,
                                    compute_silhouette_iou, threads)
@@ -118,7 +119,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StereoRefinementOptions, coarsest_level, fine
 inline void to_json(nlohmann::json& json, const ReconstructionOptions& options) {
   json = {{"shape_init", options.shape},   {"motion_init", options.motion},
           {"refinement", options.refinement}, {"refine", options.refine},
-          {"retrack", options.retrack},    {"retrack_weight", options.retrack_weight}};
+          {"retrack", options.retrack},    {"retrack_weight", options.retrack_weight},
+          {"image_edge_pixels", options.image_edge_pixels}};
 }
 inline void from_json(const nlohmann::json& json, ReconstructionOptions& options) {
   json.at("shape_init").get_to(options.shape);
@@ -127,6 +129,7 @@ inline void from_json(const nlohmann::json& json, ReconstructionOptions& options
   json.at("refine").get_to(options.refine);
   json.at("retrack").get_to(options.retrack);
   json.at("retrack_weight").get_to(options.retrack_weight);
+  options.image_edge_pixels = json.value("image_edge_pixels", options.image_edge_pixels);
 }
 
 }  // namespace subflow::solver

@@ -1,8 +1,12 @@
 #include "solver/reconstruction.h"
 
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
 #include "core/error.h"
 #include "core/stopwatch.h"
 #include "vision/image_sequence.h"
+#include "vision/working_scale.h"
 
 namespace subflow::solver {
 
@@ -12,6 +16,8 @@ void ReconstructionOptions::Check() const {
   if (refine) refinement.Check();
   if (!(retrack_weight >= 0.0 && retrack_weight <= 1.0))
     ThrowError("reconstruction options", "retrack_weight", "must be in [0, 1]");
+  if (!(image_edge_pixels == 0 || (image_edge_pixels >= 0.5 && image_edge_pixels <= 1000)))
+    ThrowError("reconstruction options", "image_edge_pixels", "expected 0 (stored size) or a value in [0.5, 1000]");
 }
 
 MotionInitOptions ReconstructionOptions::RetrackOptions() const {
@@ -46,9 +52,21 @@ ReconstructionResult Reconstruct(const vision::Dataset& dataset, const Reconstru
   const int frames = static_cast<int>(result.shape.frames.size());
   std::vector<geometry::TriangleMesh> hulls;
   for (const FrameShapeInit& frame : result.shape.frames) hulls.push_back(frame.hull);
-  const vision::ImageSequence images = vision::DatasetImages(dataset, result.first_frame, frames,
-                                                             options.shape.silhouettes.source, &hulls);
   const int reference = result.shape.reference_frame - result.first_frame;
+  const geometry::Positions reference_surface =
+      hierarchy.LimitPositions(finest) * result.shape.frames[reference].control.at(finest);
+  result.image_scales.resize(dataset.camera_count());
+  std::string scales;
+  for (int k = 0; k < dataset.camera_count(); ++k) {
+    double edge = 0;
+    result.image_scales[k] = vision::SurfaceScale(dataset.camera(k), reference_surface,
+                                                  hierarchy.LevelFaces(finest), options.image_edge_pixels, &edge);
+    scales += fmt::format("{}{:.3f} ({:.1f} px)", k ? ", " : "", result.image_scales[k], edge);
+  }
+  spdlog::info("motion and refinement images at {} of the stored size (median finest edge)", scales);
+  const std::vector<vision::Camera> working = vision::ScaledCameras(dataset.cameras(), result.image_scales);
+  const vision::ImageSequence images = vision::DatasetImages(dataset, result.first_frame, frames,
+                                                             options.shape.silhouettes.source, &hulls, &working);
 
   // Motion initialization from the reference frame's fit, corrected towards every frame's.
   start.Restart();

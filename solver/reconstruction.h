@@ -33,6 +33,15 @@ struct ReconstructionOptions {
   // frames), mean end-point error / accuracy P90: 0.5 → 0.081 / 0.559 mm, 0.25 → 0.062 /
   // 0.543 mm (frames 10–12: 1.0 → 0.090 mm, 0.5 → 0.064 mm at the same accuracy).
   double retrack_weight = 0.25;
+  // Motion initialization and stereo refinement see every camera's images reduced so
+  // that the finest level's edges of the reference frame's fitted surface project to
+  // about this many pixels (vision/working_scale.h: SurfaceScale; never enlarged): finer
+  // images hold detail the surface cannot represent and cost time in proportion to
+  // their pixels. The scenes the accuracy floors were measured on have median finest
+  // edges of 1.0–2.0 px (../shared/data/blob 2.0, bust_front 1.7–2.0, take_small 1.4–1.5)
+  // and are left at their size; the 1088×1920 pose2sim take (8–11 px) is reduced to
+  // about a third. 0 = the stored size.
+  double image_edge_pixels = 3.0;
 
   void Check() const;  // throws subflow::Error naming the field
   // The options of the second motion pass: `motion` with hull_weight = retrack_weight.
@@ -47,6 +56,8 @@ struct ReconstructionResult {
   int first_frame = 0;
   std::vector<geometry::Positions> control;  // final finest control points per frame
   RigidSplit split;                          // their multires analysis and rigid motions
+  // Per camera, the scale of the images motion and refinement worked on (1 = stored size).
+  std::vector<double> image_scales;
   double shape_seconds = 0, motion_seconds = 0, refinement_seconds = 0, retrack_seconds = 0;
 
   // The stages' brief reports, one line each.

@@ -75,6 +75,9 @@ struct ShapeInitResult {
   // empty when none was estimated.
   std::vector<vision::EstimatedBackground> estimated_backgrounds;
   double estimate_background_seconds = 0;
+  // Per camera, the scale of the images the evidence was computed on (1 = stored size;
+  // VoxelCarvingOptions::max_pixels_per_voxel).
+  std::vector<double> evidence_scales;
   double simplify_seconds = 0;
 
   // One line: frames, base mesh, levels, mean silhouette IoU, seconds.
