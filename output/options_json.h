@@ -75,6 +75,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SilhouetteOptions, source, background_blur_si
                                    background_estimate_min_frames, background_estimate_margin, close_radius,
                                    fill_holes, min_region_pixels, min_object_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VoxelCarvingOptions, resolution, pixels_per_voxel, max_auto_resolution,
+                                   max_pixels_per_voxel,
                                    min_cameras, max_misses, evidence_threshold, footprint_margin, closing_radius,
                                    opening_radius, connectivity, min_component_fraction, fill_cavities,
                                    compute_silhouette_iou, threads)
@@ -96,7 +97,7 @@ namespace subflow::solver {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, carving, isosurface, simplify, fit, levels,
-                                   reference_frame, first_frame, frame_count)
+                                   reference_frame, first_frame, frame_count, image_edge_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,
                                    tessellation_density)

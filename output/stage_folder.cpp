@@ -56,6 +56,7 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
   report["reference_frame"] = state.reference_frame;
   report["levels"] = hierarchy.finest_level();
   report["evidence"] = vision::ToString(state.evidence);
+  report["image_scales"] = state.image_scales;
   WriteJsonFile(ReportPath(folder), report);
 }
 
@@ -91,6 +92,10 @@ StageRecord ReadStageFolder(const std::string& folder, const std::string& expect
       reader.Integer(reader.Required(report, "reference_frame", ""), "reference_frame", first, first + count - 1));
   state.evidence = vision::ParseEvidenceSource(reader.String(reader.Required(report, "evidence", ""), "evidence"),
                                                report_path + ": evidence");
+  state.image_scales = reader.Numbers(reader.Required(report, "image_scales", ""), -1, "image_scales");
+  for (std::size_t k = 0; k < state.image_scales.size(); ++k)
+    if (!(state.image_scales[k] > 0 && state.image_scales[k] <= 1))
+      reader.Fail("image_scales[" + std::to_string(k) + "]", "expected a scale in (0, 1]");
   const fs::path root(folder);
   state.base_mesh = ReadStageMesh(root / "base_mesh.ply");
   state.hierarchy = std::make_shared<const geometry::LoopHierarchy>(

@@ -2,7 +2,11 @@
 
 #include <algorithm>
 
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
 #include "core/error.h"
+#include "vision/working_scale.h"
 
 namespace subflow::solver {
 
@@ -74,8 +78,38 @@ geometry::Positions StageState::Surface(int i) const {
 }
 
 vision::ImageSequence StageImages(const vision::Dataset& dataset, const StageState& state) {
-  return vision::DatasetImages(dataset, state.first_frame, state.frame_count(), state.evidence, &state.hulls);
+  if (state.image_scales.empty())
+    return vision::DatasetImages(dataset, state.first_frame, state.frame_count(), state.evidence, &state.hulls);
+  if (static_cast<int>(state.image_scales.size()) != dataset.camera_count())
+    ThrowError("stage state", "image_scales",
+               "expected one per camera (" + std::to_string(dataset.camera_count()) + "), found " +
+                   std::to_string(state.image_scales.size()));
+  const std::vector<vision::Camera> working = vision::ScaledCameras(dataset.cameras(), state.image_scales);
+  return vision::DatasetImages(dataset, state.first_frame, state.frame_count(), state.evidence, &state.hulls,
+                               &working);
 }
+
+namespace {
+
+// Per camera, the scale at which the finest level's edges of the reference frame's
+// surface project to about `edge_pixels` (vision::SurfaceScale; never enlarged).
+std::vector<double> WorkingImageScales(const vision::Dataset& dataset, const StageState& state, double edge_pixels) {
+  if (edge_pixels == 0) return {};
+  const geometry::LoopHierarchy& hierarchy = state.Hierarchy();
+  const geometry::Faces& faces = hierarchy.LevelFaces(hierarchy.finest_level());
+  const geometry::Positions reference_surface = state.Surface(state.reference_index());
+  std::vector<double> scales(dataset.camera_count());
+  std::string line;
+  for (int k = 0; k < dataset.camera_count(); ++k) {
+    double edge = 0;
+    scales[k] = vision::SurfaceScale(dataset.camera(k), reference_surface, faces, edge_pixels, &edge);
+    line += fmt::format("{}{:.3f} ({:.1f} px)", k ? ", " : "", scales[k], edge);
+  }
+  spdlog::info("motion and refinement images at {} of the stored size (median finest edge)", line);
+  return scales;
+}
+
+}  // namespace
 
 StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions& options, Progress* progress,
                          ShapeInitResult* figures) {
@@ -91,6 +125,7 @@ StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions&
     state.hulls.push_back(frame.hull);
     state.control.push_back(frame.control.at(finest));
   }
+  state.image_scales = WorkingImageScales(dataset, state, options.image_edge_pixels);
   return state;
 }
 

@@ -68,6 +68,10 @@ struct StageState {
   vision::EvidenceSource evidence = vision::EvidenceSource::kAuto;
   std::vector<geometry::TriangleMesh> hulls;  // per frame: the visual hull (silhouettes of cameras without masks)
   std::vector<geometry::Positions> control;   // per frame: the finest control points #V(n)×3
+  // Per camera, the scale of the images the motion and refinement stages read (1 = the
+  // stored size; empty = every camera at 1): chosen once by the shape stage from the
+  // reference frame's fitted surface (ShapeInitOptions::image_edge_pixels).
+  std::vector<double> image_scales;
 
   int frame_count() const { return static_cast<int>(control.size()); }
   int reference_index() const { return reference_frame - first_frame; }

@@ -106,8 +106,15 @@ struct Dataset::State {
         ThrowError(path, "", "cannot open video (expected a file OpenCV's VideoCapture reads)");
       reader.next_frame = 0;
     }
+    // Seeking may be slow and inexact for some codecs (it decodes from the previous key
+    // frame); a short step forward (a subsampled pass over the video) skips frames
+    // without converting them instead.
+    constexpr int kMaxForwardSkip = 64;
+    while (reader.next_frame < frame && frame - reader.next_frame <= kMaxForwardSkip) {
+      if (!reader.capture.grab()) break;
+      ++reader.next_frame;
+    }
     if (reader.next_frame != frame) {
-      // Seeking may be slow and inexact for some codecs; sequential reads avoid it.
       reader.capture.set(cv::CAP_PROP_POS_FRAMES, frame);
       reader.next_frame = frame;
     }

@@ -12,6 +12,7 @@
 #include "vision/dataset.h"
 #include "vision/silhouettes.h"
 #include "vision/voxel_carving.h"
+#include "vision/working_scale.h"
 
 namespace subflow::vision {
 
@@ -42,10 +43,36 @@ bool UsesMotion(const Dataset& dataset, int camera, const SilhouetteOptions& opt
   return source == EvidenceSource::kMotion;
 }
 
+// The frames of one camera as the evidence sees them: the stored images, or resized to
+// the working camera when `working` is given.
+struct EvidenceImages {
+  const Dataset& dataset;
+  const std::vector<Camera>* working;
+
+  cv::Mat Fit(int camera, cv::Mat image, bool mask = false) const {
+    return working ? ResizeToCamera(image, (*working)[camera], mask) : image;
+  }
+  cv::Mat Image(int camera, int frame) const { return Fit(camera, dataset.Image(camera, frame)); }
+  cv::Mat Gray(int camera, int frame) const { return Fit(camera, dataset.Gray(camera, frame)); }
+  cv::Mat Mask(int camera, int frame) const { return Fit(camera, dataset.Mask(camera, frame), true); }
+  cv::Mat Background(int camera) const { return Fit(camera, dataset.Background(camera)); }
+  cv::Mat BackgroundGray(int camera) const { return Fit(camera, dataset.BackgroundGray(camera)); }
+  int Width(int camera) const { return working ? (*working)[camera].width() : dataset.camera(camera).width(); }
+  int Height(int camera) const { return working ? (*working)[camera].height() : dataset.camera(camera).height(); }
+};
+
+void CheckWorkingCameras(const Dataset& dataset, const std::vector<Camera>* working) {
+  SUBFLOW_CHECK(!working || static_cast<int>(working->size()) == dataset.camera_count(),
+                "one working camera per camera of the dataset");
+}
+
 }  // namespace
 
-std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, const SilhouetteOptions& options) {
+std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, const SilhouetteOptions& options,
+                                                    const std::vector<Camera>* working) {
   options.Check();
+  CheckWorkingCameras(dataset, working);
+  const EvidenceImages evidence{dataset, working};
   const int frame_count = dataset.frame_count();
   if (!options.estimate_background || options.source != EvidenceSource::kAuto ||
       frame_count < options.background_estimate_min_frames)
@@ -64,8 +91,8 @@ std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, con
     if (!UsesMotion(dataset, c, options)) return;
     std::vector<cv::Mat> images, gray;
     for (int g : frames) {
-      images.push_back(dataset.Image(c, g));
-      gray.push_back(dataset.Gray(c, g));
+      images.push_back(evidence.Image(c, g));
+      gray.push_back(evidence.Gray(c, g));
     }
     estimated[c] = EstimateBackground(images, gray, options);
   });
@@ -74,8 +101,11 @@ std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, con
 
 std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
                                              const SilhouetteOptions& options,
-                                             const std::vector<EstimatedBackground>* estimated) {
+                                             const std::vector<EstimatedBackground>* estimated,
+                                             const std::vector<Camera>* working) {
   options.Check();
+  CheckWorkingCameras(dataset, working);
+  const EvidenceImages evidence{dataset, working};
   const std::string& source_name = dataset.directory();
   if (frame < 0 || frame >= dataset.frame_count())
     ThrowError(source_name, "frame",
@@ -100,20 +130,20 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
   tbb::parallel_for(0, camera_count, [&](int c) {
     if (sources[c] == EvidenceSource::kMotion && options.source == EvidenceSource::kAuto && estimated != nullptr &&
         c < static_cast<int>(estimated->size()) && (*estimated)[c].valid()) {
-      silhouettes[c] = SilhouetteFromEstimatedBackground(dataset.Image(c, frame), (*estimated)[c], options);
+      silhouettes[c] = SilhouetteFromEstimatedBackground(evidence.Image(c, frame), (*estimated)[c], options);
       return;
     }
     switch (sources[c]) {
       case EvidenceSource::kMask:
-        silhouettes[c] = SilhouetteFromMask(dataset.Mask(c, frame), options);
+        silhouettes[c] = SilhouetteFromMask(evidence.Mask(c, frame), options);
         break;
       case EvidenceSource::kBackground:
         // Colour when both images have colour (distance in colour separates better), else gray.
         {
-          cv::Mat image = dataset.Image(c, frame), background = dataset.Background(c);
+          cv::Mat image = evidence.Image(c, frame), background = evidence.Background(c);
           if (image.type() != background.type()) {
-            image = dataset.Gray(c, frame);
-            background = dataset.BackgroundGray(c);
+            image = evidence.Gray(c, frame);
+            background = evidence.BackgroundGray(c);
           }
           silhouettes[c] = SilhouetteFromBackground(image, background, options);
         }
@@ -121,7 +151,7 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
       default: {
         if (dataset.frame_count() < 2) {
           Silhouette none = ThresholdAndClean(
-              cv::Mat::zeros(dataset.camera(c).height(), dataset.camera(c).width(), CV_32F),
+              cv::Mat::zeros(evidence.Height(c), evidence.Width(c), CV_32F),
               0.0, options);
           none.source = EvidenceSource::kMotion;
           silhouettes[c] = none;
@@ -130,7 +160,7 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
         const int first = std::max(0, frame - options.motion_window - 1);
         const int last = std::min(dataset.frame_count() - 1, frame + options.motion_window + 1);
         std::vector<cv::Mat> gray;
-        for (int g = first; g <= last; ++g) gray.push_back(dataset.Gray(c, g));
+        for (int g = first; g <= last; ++g) gray.push_back(evidence.Gray(c, g));
         silhouettes[c] = SilhouetteFromMotion(gray, frame - first, options);
       }
     }

@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "vision/dataset.h"
+#include "vision/working_scale.h"
 #include "vision/zbuffer.h"
 
 namespace subflow::vision {
@@ -19,7 +20,8 @@ cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolatio
 }
 
 ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,
-                            EvidenceSource evidence, const std::vector<geometry::TriangleMesh>* hulls) {
+                            EvidenceSource evidence, const std::vector<geometry::TriangleMesh>* hulls,
+                            const std::vector<Camera>* working) {
   if (first_frame < 0 || frame_count < 1 || first_frame + frame_count > dataset.frame_count())
     ThrowError(dataset.directory(), "frames",
                "window [" + std::to_string(first_frame) + ", " + std::to_string(first_frame + frame_count) +
@@ -27,22 +29,30 @@ ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_c
   if (hulls && static_cast<int>(hulls->size()) != frame_count)
     ThrowError(dataset.directory(), "hulls",
                std::to_string(hulls->size()) + " visual hulls for " + std::to_string(frame_count) + " frames");
+  SUBFLOW_CHECK(!working || static_cast<int>(working->size()) == dataset.camera_count(),
+                "one working camera per camera of the dataset");
   ImageSequence sequence;
-  sequence.cameras = dataset.cameras();
+  sequence.cameras = working ? *working : dataset.cameras();
   sequence.first_frame = first_frame;
   sequence.frame_count = frame_count;
-  sequence.gray = [&dataset, first_frame](int camera, int frame) {
-    return Undistorted(dataset.camera(camera), dataset.Gray(camera, first_frame + frame), cv::INTER_LINEAR);
+  const std::vector<Camera> cameras = sequence.cameras;
+  sequence.gray = [&dataset, first_frame, cameras](int camera, int frame) {
+    const Camera& working_camera = cameras[camera];
+    return Undistorted(working_camera, ResizeToCamera(dataset.Gray(camera, first_frame + frame), working_camera),
+                       cv::INTER_LINEAR);
   };
   std::vector<bool> masks(dataset.camera_count());
   for (int k = 0; k < dataset.camera_count(); ++k)
     masks[k] = (evidence == EvidenceSource::kAuto ? AutomaticSource(dataset, k) : evidence) == EvidenceSource::kMask;
-  sequence.silhouette = [&dataset, first_frame, hulls, masks](int camera, int frame) {
+  sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras](int camera, int frame) {
+    const Camera& working_camera = cameras[camera];
     if (masks[camera])
-      return Undistorted(dataset.camera(camera), dataset.Mask(camera, first_frame + frame), cv::INTER_NEAREST);
+      return Undistorted(working_camera,
+                         ResizeToCamera(dataset.Mask(camera, first_frame + frame), working_camera, true),
+                         cv::INTER_NEAREST);
     if (!hulls || (*hulls)[frame].F.rows() == 0) return cv::Mat();
     const geometry::TriangleMesh& hull = (*hulls)[frame];
-    return ZBuffer(dataset.camera(camera), hull.V, hull.F).Mask();
+    return ZBuffer(working_camera, hull.V, hull.F).Mask();
   };
   return sequence;
 }

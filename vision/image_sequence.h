@@ -47,9 +47,12 @@ cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolatio
 // evidence (`evidence`, kAuto resolved by AutomaticSource, as shape initialization does) is
 // a mask, the dataset's mask; otherwise hulls[f] (the frame's visual hull, world
 // coordinates) rendered into the camera (ZBuffer::Mask), none when `hulls` is null or that
-// hull is empty.
+// hull is empty. `working`: per camera, the working camera (vision/working_scale.h) whose
+// size every image is resized to before undistortion, and which the sequence's cameras
+// are; null = the stored cameras and sizes.
 ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,
                             EvidenceSource evidence = EvidenceSource::kAuto,
-                            const std::vector<geometry::TriangleMesh>* hulls = nullptr);
+                            const std::vector<geometry::TriangleMesh>* hulls = nullptr,
+                            const std::vector<Camera>* working = nullptr);
 
 }  // namespace subflow::vision

@@ -44,6 +44,7 @@
 
 namespace subflow::vision {
 
+class Camera;
 class Dataset;
 
 enum class EvidenceSource {
@@ -270,15 +271,19 @@ bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras =
 // returned as it is. Throws subflow::Error when a forced source is missing from the dataset.
 // `estimated`: per camera, a background estimated from the video (EstimateBackgrounds),
 // used instead of motion evidence by a camera whose source (kAuto) would be motion.
+// `working`: per camera, the working camera (vision/working_scale.h) whose size the
+// images are resized to before anything is computed; null = the stored size.
 std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
                                              const SilhouetteOptions& options = {},
-                                             const std::vector<EstimatedBackground>* estimated = nullptr);
+                                             const std::vector<EstimatedBackground>* estimated = nullptr,
+                                             const std::vector<Camera>* working = nullptr);
 // Backgrounds estimated from the video for every camera whose kAuto source would be
 // motion (no masks, no background/<camera>.png), from all frames of the dataset (at
 // most 64, evenly spaced); empty entries for the other cameras. Empty when
 // options.estimate_background is off, options.source is not kAuto, or the dataset has
-// fewer than background_estimate_min_frames frames.
-std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, const SilhouetteOptions& options = {});
+// fewer than background_estimate_min_frames frames. `working` as for ComputeFrameEvidence.
+std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, const SilhouetteOptions& options = {},
+                                                     const std::vector<Camera>* working = nullptr);
 // ComputeFrameEvidence, and when every motion silhouette is empty the error
 // "<dataset>: frame N: no masks, no background, and no motion: cannot find the object".
 std::vector<Silhouette> ComputeSilhouettes(const Dataset& dataset, int frame,

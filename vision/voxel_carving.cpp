@@ -154,6 +154,8 @@ void VoxelCarvingOptions::Check() const {
   if (resolution < 0 || resolution > 2048) fail("resolution", "0 (automatic) or 1..2048", resolution);
   if (!(pixels_per_voxel > 0 && pixels_per_voxel <= 1000)) fail("pixels_per_voxel", "a value in (0, 1000]", pixels_per_voxel);
   if (max_auto_resolution < 8 || max_auto_resolution > 2048) fail("max_auto_resolution", "8..2048", max_auto_resolution);
+  if (!(max_pixels_per_voxel == 0 || max_pixels_per_voxel >= 1))
+    fail("max_pixels_per_voxel", "0 (stored size) or at least 1", max_pixels_per_voxel);
   if (min_cameras < 1) fail("min_cameras", "at least 1", min_cameras);
   if (max_misses < -1) fail("max_misses", "-1 (automatic) or ≥ 0", max_misses);
   if (!(evidence_threshold > 0 && evidence_threshold <= 1)) fail("evidence_threshold", "a value in (0, 1]", evidence_threshold);

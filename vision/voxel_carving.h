@@ -73,6 +73,13 @@ struct VoxelCarvingOptions {
   double pixels_per_voxel = 2.0;
   // Cap of the automatic resolution (memory and time grow with its cube).
   int max_auto_resolution = 160;
+  // Shape initialization computes the evidence (silhouettes, estimated background) on
+  // images reduced so that a voxel spans at most this many pixels at the volume's centre
+  // (vision/working_scale.h: EvidenceScale); never enlarged. A voxel's evidence is the
+  // mean over its footprint, so finer images only cost time: an HD take whose voxels span
+  // 13–15 px (the 160-voxel cap over a room-sized volume) is carved from ~1/4-size images.
+  // 0 = the stored size.
+  double max_pixels_per_voxel = 4.0;
   // A voxel must be seen AND supported (evidence ≥ threshold) by at least this many
   // cameras to be occupied. 2 = the fewest that triangulate; raise it on dense rigs.
   int min_cameras = 2;

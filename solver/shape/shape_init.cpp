@@ -11,6 +11,7 @@
 #include "core/stopwatch.h"
 #include "geometry/closest_point.h"
 #include "core/error.h"
+#include "vision/working_scale.h"
 
 namespace subflow::solver {
 namespace {
@@ -58,6 +59,47 @@ void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std:
   }
 }
 
+// The visual hull of every frame (FrameShapeInit's carving, hull and times) from the
+// evidence of `silhouettes`; has_evidence / all_empty per frame as
+// TakeHullsOfFramesWithoutEvidence reads them.
+struct HullStage {
+  const vision::Dataset& dataset;
+  const vision::VoxelCarvingOptions& carving;
+  const geometry::IsosurfaceOptions& isosurface;
+  const std::vector<vision::Camera>& cameras;  // the evidence's working cameras
+  const std::vector<vision::EstimatedBackground>& estimated;
+
+  void Run(const vision::SilhouetteOptions& silhouette_options, Progress* progress,
+           std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
+           std::vector<bool>* all_empty) const {
+    const int count = static_cast<int>(frames->size());
+    ProgressBegin(progress, "visual hull", count);
+    for (int i = 0; i < count; ++i) {
+      FrameShapeInit& frame = (*frames)[i];
+      Stopwatch start;
+      const std::vector<vision::Silhouette> silhouettes =
+          vision::ComputeFrameEvidence(dataset, frame.frame, silhouette_options, &estimated, &cameras);
+      (*has_evidence)[i] = !vision::LacksEvidence(silhouettes, carving.min_cameras);
+      // Empty masks or background differences say the object is absent (motion evidence
+      // only that nothing moves).
+      (*all_empty)[i] = std::all_of(silhouettes.begin(), silhouettes.end(), [](const vision::Silhouette& s) {
+        return s.empty && s.source != vision::EvidenceSource::kMotion;
+      });
+      if ((*has_evidence)[i]) {
+        frame.carving = vision::CarveVoxels(cameras, silhouettes, dataset.bounds(), carving, frame.frame);
+        frame.carve_seconds = start.Seconds();
+        start.Restart();
+        frame.hull = geometry::ExtractIsosurface(frame.carving.occupancy, isosurface, &frame.isosurface,
+                                                 "occupancy of frame " + vision::FrameName(frame.frame));
+        frame.isosurface_seconds = start.Seconds();
+        frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
+      }
+      ProgressUpdate(progress, i + 1);
+    }
+    ProgressEnd(progress);
+  }
+};
+
 }  // namespace
 
 std::string ShapeInitResult::BriefReport() const {
@@ -84,6 +126,8 @@ void ShapeInitOptions::Check() const {
   if (first_frame < 0) ThrowError("shape init options", "first_frame", "expected ≥ 0");
   if (frame_count == 0 || frame_count < -1)
     ThrowError("shape init options", "frame_count", "expected > 0, or −1 for all frames");
+  if (!(image_edge_pixels == 0 || (image_edge_pixels >= 0.5 && image_edge_pixels <= 1000)))
+    ThrowError("shape init options", "image_edge_pixels", "expected 0 (stored size) or a value in [0.5, 1000]");
 }
 
 ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitOptions& options,
@@ -105,10 +149,26 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   ShapeInitResult result;
   result.reference_frame = reference;
   result.frames.resize(count);
+  for (int i = 0; i < count; ++i) result.frames[i].frame = result.frames[i].hull_from_frame = first + i;
+
+  // Evidence on images reduced to what the voxel grid resolves (vision/working_scale.h),
+  // the grid's resolution fixed first so that it does not follow the reduced cameras.
+  vision::VoxelCarvingOptions carving = options.carving;
+  carving.resolution = vision::ChooseResolution(dataset.cameras(), dataset.bounds(), options.carving);
+  const double voxel_size = dataset.bounds().Size().maxCoeff() / carving.resolution;
+  result.evidence_scales.resize(dataset.camera_count());
+  for (int k = 0; k < dataset.camera_count(); ++k)
+    result.evidence_scales[k] =
+        vision::EvidenceScale(dataset.camera(k), dataset.bounds(), voxel_size, options.carving.max_pixels_per_voxel);
+  const std::vector<vision::Camera> evidence_cameras = vision::ScaledCameras(dataset.cameras(), result.evidence_scales);
+  std::string scales;
+  for (double scale : result.evidence_scales) scales += fmt::format("{}{:.3f}", scales.empty() ? "" : " ", scale);
+  spdlog::info("evidence images at {} of the stored size (voxels of {:.4g}, {} along the longest axis)", scales,
+               voxel_size, carving.resolution);
 
   // Without masks and background images: backgrounds estimated from the video.
   Stopwatch estimate_start;
-  result.estimated_backgrounds = vision::EstimateBackgrounds(dataset, options.silhouettes);
+  result.estimated_backgrounds = vision::EstimateBackgrounds(dataset, options.silhouettes, &evidence_cameras);
   result.estimate_background_seconds = estimate_start.Seconds();
   for (const vision::EstimatedBackground& estimated : result.estimated_backgrounds)
     if (estimated.valid()) {
@@ -119,32 +179,8 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
 
   // Visual hull of every frame with evidence.
   std::vector<bool> has_evidence(count, false), all_empty(count, false);
-  ProgressBegin(progress, "visual hull", count);
-  for (int i = 0; i < count; ++i) {
-    FrameShapeInit& frame = result.frames[i];
-    frame.frame = frame.hull_from_frame = first + i;
-    Stopwatch start;
-    const std::vector<vision::Silhouette> silhouettes =
-        vision::ComputeFrameEvidence(dataset, frame.frame, options.silhouettes, &result.estimated_backgrounds);
-    has_evidence[i] = !vision::LacksEvidence(silhouettes, options.carving.min_cameras);
-    // Empty masks or background differences say the object is absent (motion evidence only
-    // that nothing moves).
-    all_empty[i] = std::all_of(silhouettes.begin(), silhouettes.end(), [](const vision::Silhouette& silhouette) {
-      return silhouette.empty && silhouette.source != vision::EvidenceSource::kMotion;
-    });
-    if (has_evidence[i]) {
-      frame.carving = vision::CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), options.carving,
-                                          frame.frame);
-      frame.carve_seconds = start.Seconds();
-      start.Restart();
-      frame.hull = geometry::ExtractIsosurface(frame.carving.occupancy, options.isosurface, &frame.isosurface,
-                                               "occupancy of frame " + vision::FrameName(frame.frame));
-      frame.isosurface_seconds = start.Seconds();
-      frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
-    }
-    ProgressUpdate(progress, i + 1);
-  }
-  ProgressEnd(progress);
+  const HullStage stage{dataset, carving, options.isosurface, evidence_cameras, result.estimated_backgrounds};
+  stage.Run(options.silhouettes, progress, &result.frames, &has_evidence, &all_empty);
   for (vision::EstimatedBackground& estimated : result.estimated_backgrounds)  // memory: keep the figures
     estimated.image.release(), estimated.known.release();
   TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames);

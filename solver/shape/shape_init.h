@@ -44,6 +44,16 @@ struct ShapeInitOptions {
   // Frames [first_frame, first_frame + frame_count); frame_count −1 = to the end.
   int first_frame = 0;
   int frame_count = -1;
+  // Motion initialization and stereo refinement see every camera's images reduced so
+  // that the finest level's edges of the reference frame's fitted surface project to
+  // about this many pixels (vision/working_scale.h: SurfaceScale; never enlarged): finer
+  // images hold detail the surface cannot represent and cost time in proportion to
+  // their pixels. The scenes the accuracy floors were measured on have median finest
+  // edges of 1.0–2.0 px (../shared/data/blob 2.0, bust_front 1.7–2.0, take_small 1.4–1.5)
+  // and are left at their size; the 1088×1920 pose2sim take (8–11 px) is reduced to
+  // about a third. 0 = the stored size. The shape stage chooses the scales
+  // (StageState::image_scales), the later stages read them.
+  double image_edge_pixels = 3.0;
 
   void Check() const;  // throws subflow::Error naming the field
 };
@@ -75,6 +85,9 @@ struct ShapeInitResult {
   // empty when none was estimated.
   std::vector<vision::EstimatedBackground> estimated_backgrounds;
   double estimate_background_seconds = 0;
+  // Per camera, the scale of the images the evidence was computed on (1 = stored size;
+  // VoxelCarvingOptions::max_pixels_per_voxel).
+  std::vector<double> evidence_scales;
   double simplify_seconds = 0;
 
   // One line: frames, base mesh, levels, mean silhouette IoU, seconds.

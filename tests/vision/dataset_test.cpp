@@ -320,6 +320,25 @@ TEST(Dataset, ReadsFramesFromVideos) {
     EXPECT_EQ(cv::norm(dataset.Image(1, f), RandomImage(32, 24, CV_8UC3, 50 + f), cv::NORM_INF), 0.0) << f;
 }
 
+TEST(Dataset, SkipsForwardThroughAVideoWithoutTheCache) {
+  const fs::path dir = Scratch().Subdirectory("videos_skip");
+  const std::vector<Camera> cameras = {LookAt("a", {-1, -1, 0.3}, 32, 24, 30), LookAt("b", {1, -1, 0.3}, 32, 24, 30)};
+  WriteCamerasJson((dir / "cameras.json").string(), cameras, 25.0, std::nullopt, std::nullopt);
+  fs::create_directories(dir / "videos");
+  for (const Camera& camera : cameras) {
+    cv::VideoWriter writer((dir / "videos" / (camera.name() + ".avi")).string(),
+                           cv::VideoWriter::fourcc('F', 'F', 'V', '1'), 25, cv::Size(32, 24), true);
+    ASSERT_TRUE(writer.isOpened());
+    for (int f = 0; f < 9; ++f) writer.write(RandomImage(32, 24, CV_8UC3, 70 + f));
+  }
+  DatasetOptions options;
+  options.cache_frames = 0;  // every read decodes
+  const Dataset dataset(dir.string(), options);
+  // A subsampled pass (skips forward), then a step back (seeks), then forward again.
+  for (int f : {0, 3, 4, 8, 2, 7})
+    EXPECT_EQ(cv::norm(dataset.Image(0, f), RandomImage(32, 24, CV_8UC3, 70 + f), cv::NORM_INF), 0.0) << f;
+}
+
 // --- Malformed inputs: one test each, asserting that the message names the file, the
 // field and the expectation.
 
