@@ -83,6 +83,10 @@ void BM_MotionStep(benchmark::State& state) {
   state.counters["cg_iterations"] = step.report.cg_iterations;
   state.counters["photometric_zero"] = step.report.photometric_rms_zero;
   state.counters["photometric"] = step.report.photometric_rms;
+  for (const solver::LevelSolveReport& level : step.solution.levels) {
+    state.counters["unknowns_" + std::to_string(level.level)] = level.unknowns;
+    state.counters["cg_last_" + std::to_string(level.level)] = level.cg_iterations;
+  }
 }
 BENCHMARK(BM_MotionStep)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
 
