@@ -41,6 +41,30 @@ Sparse Kron3(const Matrix& A) {
   return result;
 }
 
+// A B for row-major sparse A and B with 3 columns, parallel over A's rows; each row sums its
+// entries in order (the same sums as Eigen's product).
+Positions RowParallelProduct(const geometry::SparseMatrix& A, const Positions& B) {
+  SUBFLOW_CHECK(A.cols() == B.rows(), "product of mismatched sizes");
+  Positions result(A.rows(), 3);
+  tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(A.rows()), 2048),
+                    [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) {
+      double x = 0.0, y = 0.0, z = 0.0;
+      for (int k = A.outerIndexPtr()[r]; k < A.outerIndexPtr()[r + 1]; ++k) {
+        const double w = A.valuePtr()[k];
+        const int c = A.innerIndexPtr()[k];
+        x += w * B(c, 0);
+        y += w * B(c, 1);
+        z += w * B(c, 2);
+      }
+      result(r, 0) = x;
+      result(r, 1) = y;
+      result(r, 2) = z;
+    }
+  });
+  return result;
+}
+
 }  // namespace
 
 void NormalFlowSolverOptions::Check() const {
@@ -103,6 +127,7 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   // Prolongations P_i = C(n−1)⋯C(i), Laplacian Gram matrices, length scales.
   prolongation3_.resize(n_ + 1);
   level_limit_.resize(n_ + 1);
+  level_limit_transpose_.resize(n_ + 1);
   coarsening_.resize(n_ + 1);
   level_matrix_.resize(n_ + 1);
   smoothness3_.resize(n_ + 1);
@@ -137,6 +162,7 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
         level_limit_[level].prune(1.0, kCancelledWeight);
         level_limit_[level].makeCompressed();
       }
+      level_limit_transpose_[level] = level_limit_[level].transpose();
       prolongation3_[level] = Kron3(P);
       const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(hierarchy.Topology(level));
       smoothness3_[level] = Kron3(geometry::SparseMatrix(U.transpose() * U));
@@ -226,7 +252,7 @@ std::vector<double> NormalFlowSolver::DataSums(
 
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
   SUBFLOW_CHECK(displacement.rows() == limit_.cols(), "displacement of another level");
-  return limit_ * displacement;
+  return RowParallelProduct(limit_, displacement);
 }
 
 std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
@@ -253,14 +279,31 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> M =
       Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>::Zero(samples, 6);
   Positions h = Positions::Zero(samples, 3);
-  for (int c = 0; c < constraints.size(); ++c) {
-    const double w = weights(c);
-    if (w == 0.0) continue;
-    const Eigen::RowVector3d g = constraints.gradient.row(c);
-    const int s = constraints.sample[c];
-    M.row(s) += w * Eigen::Matrix<double, 1, 6>(g(0) * g(0), g(0) * g(1), g(0) * g(2),
-                                                g(1) * g(1), g(1) * g(2), g(2) * g(2));
-    h.row(s) += (w * constraints.rhs(c)) * g;
+  auto aggregate = [&](int first, int last) {
+    for (int c = first; c < last; ++c) {
+      const double w = weights(c);
+      if (w == 0.0) continue;
+      const Eigen::RowVector3d g = constraints.gradient.row(c);
+      const int s = constraints.sample[c];
+      M.row(s) += w * Eigen::Matrix<double, 1, 6>(g(0) * g(0), g(0) * g(1), g(0) * g(2),
+                                                  g(1) * g(1), g(1) * g(2), g(2) * g(2));
+      h.row(s) += (w * constraints.rhs(c)) * g;
+    }
+  };
+  // Rows ordered by sample (as the builders make them): parallel over chunks that end at a
+  // sample boundary, each sample's rows still added in row order.
+  if (std::is_sorted(constraints.sample.begin(), constraints.sample.end())) {
+    const int chunk_count = std::max(1, constraints.size() / 16384);
+    std::vector<int> bounds(chunk_count + 1, constraints.size());
+    bounds[0] = 0;
+    for (int i = 1; i < chunk_count; ++i) {
+      int c = static_cast<int>(static_cast<long>(constraints.size()) * i / chunk_count);
+      while (c > 0 && c < constraints.size() && constraints.sample[c] == constraints.sample[c - 1]) ++c;
+      bounds[i] = std::max(bounds[i - 1], c);
+    }
+    tbb::parallel_for(0, chunk_count, [&](int i) { aggregate(bounds[i], bounds[i + 1]); });
+  } else {
+    aggregate(0, constraints.size());
   }
   solution->displacement = Positions::Zero(vertices, 3);
   VectorMap D(solution->displacement.data(), 3 * vertices);
@@ -303,7 +346,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
           sample_rhs(s, 2) = h(s, 2) - (m6[2] * u0 + m6[4] * u1 + m6[5] * u2);
         }
       });
-      const Positions data_rhs = level_limit.transpose() * sample_rhs;
+      const Positions data_rhs = RowParallelProduct(level_limit_transpose_[level], sample_rhs);
       const Eigen::VectorXd rhs = ConstVectorMap(data_rhs.data(), unknowns) -
                                   report.smoothness_weight * (smoothness3_[level] * W);
       // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
@@ -318,7 +361,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       x.setZero();
     }
     D += P3 * x;
-    sample_motion += level_limit * delta;
+    sample_motion += RowParallelProduct(level_limit, delta);
     solution->cg_iterations += report.cg_iterations;
     solution->levels.push_back(report);
     if (level < hi_)

@@ -184,6 +184,7 @@ class NormalFlowSolver {
   geometry::SparseMatrix limit_;       // L, row-major
   SampleStencils stencils_;            // of level hi
   std::vector<geometry::SparseMatrix> level_limit_;  // L P_i (#S × #V(i)), by level lo..hi
+  std::vector<geometry::SparseMatrix> level_limit_transpose_;  // (L P_i)ᵀ, row-major
   std::vector<geometry::SparseMatrix> coarsening_;  // block sums of level i+1 → i, by level lo..hi−1
   std::vector<LevelMatrix> level_matrix_;  // CG matrix structure, by level lo..hi
   std::vector<Sparse> prolongation3_;  // P_i ⊗ I3 (3#V(n) × 3#V(i)), by level
