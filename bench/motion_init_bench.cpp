@@ -14,13 +14,17 @@
 // control points, 20480 faces; `subflow reconstruct` fits 3 levels on a ~400-face hull).
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 
 #include <benchmark/benchmark.h>
 
 #include "geometry/closest_point.h"
 #include "geometry/icosphere.h"
 #include "geometry/loop_hierarchy.h"
+#include "geometry/loop_operators.h"
 #include "geometry/mesh_io.h"
+#include "solver/motion/conjugate_gradient.h"
+#include "solver/motion/level_matrices.h"
 #include "solver/motion/motion_init.h"
 #include "solver/shape/surface_snapping.h"
 #include "vision/dataset.h"
@@ -83,8 +87,12 @@ void BM_MotionStep(benchmark::State& state) {
   state.counters["cg_iterations"] = step.report.cg_iterations;
   state.counters["photometric_zero"] = step.report.photometric_rms_zero;
   state.counters["photometric"] = step.report.photometric_rms;
+  for (const solver::LevelSolveReport& level : step.solution.levels) {
+    state.counters["unknowns_" + std::to_string(level.level)] = level.unknowns;
+    state.counters["cg_last_" + std::to_string(level.level)] = level.cg_iterations;
+  }
 }
-BENCHMARK(BM_MotionStep)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_MotionStep)->Unit(benchmark::kSecond)->MeasureProcessCPUTime()->UseRealTime()->Iterations(3);
 
 // Reference: the visibility stage alone (tessellation, 10 z-buffers, per-sample tests).
 void BM_VisibilityReference(benchmark::State& state) {
@@ -120,6 +128,140 @@ void BM_ConstraintsReference(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ConstraintsReference)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The CG matrices of the solver's levels from the block sums of the finest estimated level
+// (one IRLS solve's worth), on the blob's sample stencils: the current path
+// (level_matrices.h: precomputed coarsening map, values written into a fixed pattern)
+// against the previous one kept as the reference (Kron3 sparse triple products per level,
+// then A += κ·regularizer as an Eigen sparse sum). Both start from the interleaved
+// finest-level matrix / its block sums; max_difference compares their matrices.
+using Sparse = Eigen::SparseMatrix<double>;
+
+Sparse Kron3(const geometry::SparseMatrix& A) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int r = 0; r < A.outerSize(); ++r)
+    for (geometry::SparseMatrix::InnerIterator it(A, r); it; ++it)
+      for (int a = 0; a < 3; ++a)
+        triplets.emplace_back(3 * static_cast<int>(it.row()) + a, 3 * static_cast<int>(it.col()) + a, it.value());
+  Sparse result(3 * A.rows(), 3 * A.cols());
+  result.setFromTriplets(triplets.begin(), triplets.end());
+  return result;
+}
+
+struct LevelMatricesCase {
+  int lo = 0, hi = 0;
+  std::vector<solver::SymmetricPattern> pattern;
+  std::vector<geometry::SparseMatrix> map;    // level + 1 → level
+  std::vector<Sparse> refinement3, regularizer3;
+  std::vector<solver::LevelMatrix> level;
+  std::vector<double> sums;                   // of level hi
+  Sparse finest;                              // interleaved data matrix of level hi
+
+  LevelMatricesCase() {
+    const Blob& blob = GetBlob();
+    const solver::MotionStepEstimator estimator(blob.hierarchy, blob.dataset.cameras(), blob.fits[0]);
+    lo = estimator.solver().coarsest_level();
+    hi = estimator.solver().finest_estimated_level();
+    geometry::SparseMatrix L = estimator.samples().limit;
+    for (int l = kLevels - 1; l >= hi; --l) L = geometry::SparseMatrix(L * blob.hierarchy.Refinement(l));
+    L.prune(1.0, 1e-12);
+    Sparse ones = L;
+    for (int k = 0; k < ones.outerSize(); ++k)
+      for (Sparse::InnerIterator it(ones, k); it; ++it) it.valueRef() = 1.0;
+    pattern.resize(hi + 1);
+    map.resize(hi + 1);
+    refinement3.resize(hi + 1);
+    regularizer3.resize(hi + 1);
+    level.resize(hi + 1);
+    pattern[hi] = solver::MakeSymmetricPattern(Sparse(ones.transpose() * ones));
+    for (int l = hi - 1; l >= lo; --l) {
+      map[l] = solver::CoarseningMap(pattern[l + 1], blob.hierarchy.Refinement(l), &pattern[l]);
+      refinement3[l] = Kron3(blob.hierarchy.Refinement(l));
+    }
+    for (int l = lo; l <= hi; ++l) {
+      const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(blob.hierarchy.Topology(l));
+      Sparse identity(3 * U.rows(), 3 * U.rows());
+      identity.setIdentity();
+      regularizer3[l] = Kron3(geometry::SparseMatrix(U.transpose() * U)) + 0.01 * identity;
+      level[l] = solver::MakeLevelMatrix(pattern[l], regularizer3[l]);
+    }
+    sums.assign(6 * static_cast<std::size_t>(pattern[hi].entries()), 0.0);
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> value(0.0, 1.0);
+    for (double& v : sums) v = value(random);
+    const Sparse empty(regularizer3[hi].rows(), regularizer3[hi].cols());
+    finest = solver::AssembleLevelMatrix(solver::MakeLevelMatrix(pattern[hi], empty), sums, 0.0);
+  }
+};
+
+const LevelMatricesCase& GetLevelMatricesCase() {
+  static const LevelMatricesCase instance;
+  return instance;
+}
+
+std::vector<Sparse> LevelMatricesReference(const LevelMatricesCase& c) {
+  std::vector<Sparse> data(c.hi + 1);
+  data[c.hi] = c.finest;
+  for (int l = c.hi - 1; l >= c.lo; --l)
+    data[l] = Sparse(c.refinement3[l].transpose() * Sparse(data[l + 1] * c.refinement3[l]));
+  for (int l = c.lo; l <= c.hi; ++l) {
+    const double stiffness = data[l].diagonal().sum() / data[l].rows();
+    data[l] += stiffness * c.regularizer3[l];
+    data[l].makeCompressed();
+  }
+  return data;
+}
+
+std::vector<Sparse> LevelMatricesCurrent(const LevelMatricesCase& c) {
+  std::vector<std::vector<double>> sums(c.hi + 1);
+  sums[c.hi] = c.sums;
+  for (int l = c.hi - 1; l >= c.lo; --l) sums[l] = solver::CoarsenBlockSums(c.map[l], sums[l + 1]);
+  std::vector<Sparse> matrices(c.hi + 1);
+  for (int l = c.lo; l <= c.hi; ++l)
+    matrices[l] = solver::AssembleLevelMatrix(c.level[l], sums[l], solver::DataStiffness(c.level[l], sums[l]));
+  return matrices;
+}
+
+void BM_LevelMatricesReference(benchmark::State& state) {
+  const LevelMatricesCase& c = GetLevelMatricesCase();
+  for (auto _ : state) benchmark::DoNotOptimize(LevelMatricesReference(c).data());
+  state.counters["finest_unknowns"] = static_cast<double>(c.finest.rows());
+}
+BENCHMARK(BM_LevelMatricesReference)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+
+void BM_LevelMatrices(benchmark::State& state) {
+  const LevelMatricesCase& c = GetLevelMatricesCase();
+  for (auto _ : state) benchmark::DoNotOptimize(LevelMatricesCurrent(c).data());
+  const std::vector<Sparse> reference = LevelMatricesReference(c), current = LevelMatricesCurrent(c);
+  double difference = 0.0;
+  for (int l = c.lo; l <= c.hi; ++l) difference = std::max(difference, Eigen::MatrixXd(reference[l] - current[l]).cwiseAbs().maxCoeff());
+  state.counters["max_difference"] = difference;
+}
+BENCHMARK(BM_LevelMatrices)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+
+// The CG matrix–vector product on the finest estimated level's assembled matrix: the 3×3
+// block form (conjugate_gradient.h) against the scalar column form kept as the reference.
+void BM_CgProductReference(benchmark::State& state) {
+  const LevelMatricesCase& c = GetLevelMatricesCase();
+  const Sparse A = LevelMatricesCurrent(c)[c.hi];
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 1.0);
+  Eigen::VectorXd y(A.rows());
+  for (auto _ : state) solver::MultiplySymmetric(A, x, &y);
+  state.counters["nonzeros"] = static_cast<double>(A.nonZeros());
+}
+BENCHMARK(BM_CgProductReference)->Unit(benchmark::kMicrosecond)->MeasureProcessCPUTime()->UseRealTime();
+
+void BM_CgProduct(benchmark::State& state) {
+  const LevelMatricesCase& c = GetLevelMatricesCase();
+  const Sparse A = LevelMatricesCurrent(c)[c.hi];
+  const solver::BlockSparseMatrix blocks = solver::MakeBlockSparse(A);
+  const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(A.rows(), -1.0, 1.0);
+  Eigen::VectorXd y(A.rows()), reference(A.rows());
+  for (auto _ : state) solver::MultiplySymmetric(blocks, x, &y);
+  solver::MultiplySymmetric(A, x, &reference);
+  state.counters["max_difference"] = (y - reference).cwiseAbs().maxCoeff();
+}
+BENCHMARK(BM_CgProduct)->Unit(benchmark::kMicrosecond)->MeasureProcessCPUTime()->UseRealTime();
 
 // End-point error of a per-frame sequence of finest control points, on the limit
 // tessellation (density 2), motion = vertex differences (or zero).

@@ -1,5 +1,6 @@
 #include "solver/motion/conjugate_gradient.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/blocked_range.h>
@@ -9,10 +10,61 @@
 #include "solver/motion/block_jacobi_preconditioner.h"
 
 namespace subflow::solver {
-namespace {
+BlockSparseMatrix MakeBlockSparse(const Eigen::SparseMatrix<double>& A) {
+  SUBFLOW_CHECK(A.rows() == A.cols() && A.rows() % 3 == 0, "block sparse: 3#V square matrix expected");
+  const int blocks = static_cast<int>(A.cols() / 3);
+  BlockSparseMatrix result;
+  result.outer.assign(blocks + 1, 0);
+  std::vector<std::vector<int>> rows(blocks);
+  tbb::parallel_for(0, blocks, [&](int v) {
+    for (int b = 0; b < 3; ++b)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, 3 * v + b); it; ++it)
+        rows[v].push_back(static_cast<int>(it.row() / 3));
+    std::sort(rows[v].begin(), rows[v].end());
+    rows[v].erase(std::unique(rows[v].begin(), rows[v].end()), rows[v].end());
+  });
+  for (int v = 0; v < blocks; ++v) result.outer[v + 1] = result.outer[v] + static_cast<int>(rows[v].size());
+  result.row.resize(result.outer.back());
+  result.values.assign(9 * static_cast<std::size_t>(result.outer.back()), 0.0);
+  tbb::parallel_for(0, blocks, [&](int v) {
+    std::copy(rows[v].begin(), rows[v].end(), result.row.begin() + result.outer[v]);
+    for (int b = 0; b < 3; ++b) {
+      int k = result.outer[v];
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, 3 * v + b); it; ++it) {
+        while (result.row[k] != it.row() / 3) ++k;
+        result.values[9 * static_cast<std::size_t>(k) + 3 * b + it.row() % 3] = it.value();
+      }
+    }
+  });
+  return result;
+}
 
-// y = A x for symmetric A: column j of A is row j, so each y_j is one column's dot product.
-void Multiply(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x, Eigen::VectorXd* y) {
+void MultiplySymmetric(const BlockSparseMatrix& A, const Eigen::VectorXd& x, Eigen::VectorXd* y) {
+  const int* outer = A.outer.data();
+  const int* row = A.row.data();
+  const double* values = A.values.data();
+  const double* in = x.data();
+  double* out = y->data();
+  tbb::parallel_for(tbb::blocked_range<int>(0, A.blocks(), 256), [&](const tbb::blocked_range<int>& range) {
+    for (int v = range.begin(); v < range.end(); ++v) {
+      double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+      for (int k = outer[v]; k < outer[v + 1]; ++k) {
+        const double* block = values + 9 * static_cast<std::size_t>(k);
+        const double* xu = in + 3 * static_cast<std::size_t>(row[k]);
+        for (int a = 0; a < 3; ++a) {  // rows 3u + a in ascending order, as in the scalar form
+          y0 += block[a] * xu[a];
+          y1 += block[3 + a] * xu[a];
+          y2 += block[6 + a] * xu[a];
+        }
+      }
+      out[3 * v] = y0;
+      out[3 * v + 1] = y1;
+      out[3 * v + 2] = y2;
+    }
+  });
+}
+
+void MultiplySymmetric(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x, Eigen::VectorXd* y) {
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
   const double* values = A.valuePtr();
@@ -28,8 +80,6 @@ void Multiply(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& x, Ei
   });
 }
 
-}  // namespace
-
 ConjugateGradientResult SolveConjugateGradient(const Eigen::SparseMatrix<double>& A,
                                                const Eigen::VectorXd& b, double tolerance,
                                                int max_iterations, Eigen::VectorXd* x) {
@@ -42,8 +92,9 @@ ConjugateGradientResult SolveConjugateGradient(const Eigen::SparseMatrix<double>
     return result;
   }
   const BlockJacobiPreconditioner preconditioner(A);
+  const BlockSparseMatrix blocks = MakeBlockSparse(A);
   Eigen::VectorXd r(b.size()), Ap(b.size());
-  Multiply(A, *x, &Ap);
+  MultiplySymmetric(blocks, *x, &Ap);
   r = b - Ap;
   const double threshold = tolerance * b_norm;
   double r_norm = r.norm();
@@ -51,7 +102,7 @@ ConjugateGradientResult SolveConjugateGradient(const Eigen::SparseMatrix<double>
   Eigen::VectorXd p = z;
   double rz = r.dot(z);
   while (r_norm > threshold && result.iterations < max_iterations) {
-    Multiply(A, p, &Ap);
+    MultiplySymmetric(blocks, p, &Ap);
     const double alpha = rz / p.dot(Ap);
     *x += alpha * p;
     r -= alpha * Ap;

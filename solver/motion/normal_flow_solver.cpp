@@ -41,6 +41,30 @@ Sparse Kron3(const Matrix& A) {
   return result;
 }
 
+// A B for row-major sparse A and B with 3 columns, parallel over A's rows; each row sums its
+// entries in order (the same sums as Eigen's product).
+Positions RowParallelProduct(const geometry::SparseMatrix& A, const Positions& B) {
+  SUBFLOW_CHECK(A.cols() == B.rows(), "product of mismatched sizes");
+  Positions result(A.rows(), 3);
+  tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(A.rows()), 2048),
+                    [&](const tbb::blocked_range<int>& range) {
+    for (int r = range.begin(); r < range.end(); ++r) {
+      double x = 0.0, y = 0.0, z = 0.0;
+      for (int k = A.outerIndexPtr()[r]; k < A.outerIndexPtr()[r + 1]; ++k) {
+        const double w = A.valuePtr()[k];
+        const int c = A.innerIndexPtr()[k];
+        x += w * B(c, 0);
+        y += w * B(c, 1);
+        z += w * B(c, 2);
+      }
+      result(r, 0) = x;
+      result(r, 1) = y;
+      result(r, 2) = z;
+    }
+  });
+  return result;
+}
+
 }  // namespace
 
 void NormalFlowSolverOptions::Check() const {
@@ -103,9 +127,11 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   // Prolongations P_i = C(n−1)⋯C(i), Laplacian Gram matrices, length scales.
   prolongation3_.resize(n_ + 1);
   level_limit_.resize(n_ + 1);
-  refinement3_.resize(n_ + 1);
+  level_limit_transpose_.resize(n_ + 1);
+  coarsening_.resize(n_ + 1);
+  level_matrix_.resize(n_ + 1);
   smoothness3_.resize(n_ + 1);
-  regularizer3_.resize(n_ + 1);
+  std::vector<SymmetricPattern> data_pattern(n_ + 1);
   length_ratio4_.assign(n_ + 1, 0.0);
   geometry::SparseMatrix P(vertices, vertices);
   P.setIdentity();
@@ -122,8 +148,12 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
     ThrowError("normal flow solver", "reference control points", "are degenerate (zero size)");
   for (int level = n_; level >= lo_; --level) {
     if (level < n_) P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
-    if (level < hi_) refinement3_[level] = Kron3(hierarchy.Refinement(level));
-    if (level == hi_) stencils_ = MakeStencils(geometry::SparseMatrix(limit_ * P));
+    if (level == hi_) {
+      stencils_ = MakeStencils(geometry::SparseMatrix(limit_ * P));
+      data_pattern[level] = stencils_.pattern;
+    } else if (level < hi_) {
+      coarsening_[level] = CoarseningMap(data_pattern[level + 1], hierarchy.Refinement(level), &data_pattern[level]);
+    }
     if (level <= hi_) {
       if (level == hi_) {
         level_limit_[level] = stencils_.limit;
@@ -132,15 +162,17 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
         level_limit_[level].prune(1.0, kCancelledWeight);
         level_limit_[level].makeCompressed();
       }
+      level_limit_transpose_[level] = level_limit_[level].transpose();
       prolongation3_[level] = Kron3(P);
       const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(hierarchy.Topology(level));
       smoothness3_[level] = Kron3(geometry::SparseMatrix(U.transpose() * U));
       length_ratio4_[level] = std::pow(radius / (finest_edge * std::ldexp(1.0, n_ - level)), 4);
       Sparse identity(smoothness3_[level].rows(), smoothness3_[level].cols());
       identity.setIdentity();
-      regularizer3_[level] = options_.smoothness * length_ratio4_[level] * smoothness3_[level] +
-                             (level == lo_ ? 1e-9 : options_.detail_damping) * identity;
-      regularizer3_[level].makeCompressed();
+      Sparse regularizer3 = options_.smoothness * length_ratio4_[level] * smoothness3_[level] +
+                            (level == lo_ ? 1e-9 : options_.detail_damping) * identity;
+      regularizer3.makeCompressed();
+      level_matrix_[level] = MakeLevelMatrix(data_pattern[level], regularizer3);
     }
   }
 }
@@ -151,29 +183,16 @@ NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
   stencils.limit = limit.pruned(1.0, kCancelledWeight);
   stencils.limit.makeCompressed();
   const geometry::SparseMatrix& L = stencils.limit;
-  // Pattern of Lᵀ L (all-ones values: no cancellation), inner indices sorted (a transposed
-  // copy sorts them; the lookups below bisect).
+  // Pattern of Lᵀ L (all-ones values: no cancellation).
   Sparse ones = L;
   for (int k = 0; k < ones.outerSize(); ++k)
     for (Sparse::InnerIterator it(ones, k); it; ++it) it.valueRef() = 1.0;
-  stencils.pattern = Sparse(ones.transpose() * ones);
-  const Sparse pattern_transposed = stencils.pattern.transpose();
-  stencils.pattern = pattern_transposed.transpose();
-  stencils.pattern.makeCompressed();
-  const int* outer = stencils.pattern.outerIndexPtr();
-  const int* inner = stencils.pattern.innerIndexPtr();
+  stencils.pattern = MakeSymmetricPattern(Sparse(ones.transpose() * ones));
   auto entry = [&](int row, int column) {
-    const int* first = inner + outer[column];
-    const int* last = inner + outer[column + 1];
-    const int* found = std::lower_bound(first, last, row);
-    SUBFLOW_CHECK(found != last && *found == row, "LᵀL pattern misses a pair");
-    return static_cast<int>(found - inner);
+    const int e = stencils.pattern.Entry(row, column);
+    SUBFLOW_CHECK(e >= 0, "LᵀL pattern misses a pair");
+    return e;
   };
-  const int vertices = static_cast<int>(stencils.pattern.cols());
-  stencils.mirror.resize(static_cast<std::size_t>(stencils.pattern.nonZeros()));
-  tbb::parallel_for(0, vertices, [&](int column) {
-    for (int e = outer[column]; e < outer[column + 1]; ++e) stencils.mirror[e] = entry(column, inner[e]);
-  });
   const int samples = static_cast<int>(L.rows());
   stencils.sample_pair_offset.assign(samples + 1, 0);
   for (int s = 0; s < samples; ++s) {
@@ -192,13 +211,11 @@ NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
   return stencils;
 }
 
-NormalFlowSolver::Sparse NormalFlowSolver::DataMatrix(
+std::vector<double> NormalFlowSolver::DataSums(
     const SampleStencils& stencils, const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M) {
-  const Sparse& pattern = stencils.pattern;
   const geometry::SparseMatrix& L = stencils.limit;
-  const int vertices = static_cast<int>(pattern.cols());
   const int samples = static_cast<int>(L.rows());
-  const std::size_t entries = static_cast<std::size_t>(pattern.nonZeros());
+  const std::size_t entries = static_cast<std::size_t>(stencils.pattern.entries());
   // Block (a, b) of N = Σ_s L_sᵀ L_s ⊗ M_s is Σ_s l_sa l_sb M_s: symmetric, and equal to
   // block (b, a). Only the upper pattern entries (row ≤ column) accumulate, 6 values each.
   auto add_samples = [&](int first, int last, double* sums) {
@@ -227,44 +244,15 @@ NormalFlowSolver::Sparse NormalFlowSolver::DataMatrix(
                 static_cast<int>(static_cast<long>(samples) * (part + 1) / part_count),
                 partial[part].data());
   });
-  std::vector<double>& sums = partial[0];
   for (int part = 1; part < part_count; ++part)
-    for (std::size_t i = 0; i < sums.size(); ++i) sums[i] += partial[part][i];
+    for (std::size_t i = 0; i < partial[0].size(); ++i) partial[0][i] += partial[part][i];
 
-  // Interleaved (unknown 3v + axis): the block of pattern entry e (column j with m entries,
-  // its t-th) holds column 3j + b at values 9 outer[j] + 3 m b + 3 t + a (row 3 inner[e] + a).
-  const int* outer = pattern.outerIndexPtr();
-  const int* inner = pattern.innerIndexPtr();
-  Sparse N(3 * vertices, 3 * vertices);
-  N.resizeNonZeros(static_cast<Eigen::Index>(9 * entries));
-  int* N_outer = N.outerIndexPtr();
-  int* N_inner = N.innerIndexPtr();
-  double* values = N.valuePtr();
-  constexpr int kSym[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
-  tbb::parallel_for(tbb::blocked_range<int>(0, vertices, 256), [&](const tbb::blocked_range<int>& range) {
-    for (int j = range.begin(); j < range.end(); ++j) {
-      const int m = outer[j + 1] - outer[j];
-      for (int b = 0; b < 3; ++b) {
-        const int start = 9 * outer[j] + 3 * m * b;
-        N_outer[3 * j + b] = start;
-        for (int t = 0; t < m; ++t) {
-          const int e = outer[j] + t;
-          const double* sum = sums.data() + 6 * static_cast<std::size_t>(inner[e] <= j ? e : stencils.mirror[e]);
-          for (int a = 0; a < 3; ++a) {
-            N_inner[start + 3 * t + a] = 3 * inner[e] + a;
-            values[start + 3 * t + a] = sum[kSym[a][b]];
-          }
-        }
-      }
-    }
-  });
-  N_outer[3 * vertices] = static_cast<int>(9 * entries);
-  return N;
+  return std::move(partial[0]);
 }
 
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
   SUBFLOW_CHECK(displacement.rows() == limit_.cols(), "displacement of another level");
-  return limit_ * displacement;
+  return RowParallelProduct(limit_, displacement);
 }
 
 std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
@@ -291,14 +279,31 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> M =
       Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>::Zero(samples, 6);
   Positions h = Positions::Zero(samples, 3);
-  for (int c = 0; c < constraints.size(); ++c) {
-    const double w = weights(c);
-    if (w == 0.0) continue;
-    const Eigen::RowVector3d g = constraints.gradient.row(c);
-    const int s = constraints.sample[c];
-    M.row(s) += w * Eigen::Matrix<double, 1, 6>(g(0) * g(0), g(0) * g(1), g(0) * g(2),
-                                                g(1) * g(1), g(1) * g(2), g(2) * g(2));
-    h.row(s) += (w * constraints.rhs(c)) * g;
+  auto aggregate = [&](int first, int last) {
+    for (int c = first; c < last; ++c) {
+      const double w = weights(c);
+      if (w == 0.0) continue;
+      const Eigen::RowVector3d g = constraints.gradient.row(c);
+      const int s = constraints.sample[c];
+      M.row(s) += w * Eigen::Matrix<double, 1, 6>(g(0) * g(0), g(0) * g(1), g(0) * g(2),
+                                                  g(1) * g(1), g(1) * g(2), g(2) * g(2));
+      h.row(s) += (w * constraints.rhs(c)) * g;
+    }
+  };
+  // Rows ordered by sample (as the builders make them): parallel over chunks that end at a
+  // sample boundary, each sample's rows still added in row order.
+  if (std::is_sorted(constraints.sample.begin(), constraints.sample.end())) {
+    const int chunk_count = std::max(1, constraints.size() / 16384);
+    std::vector<int> bounds(chunk_count + 1, constraints.size());
+    bounds[0] = 0;
+    for (int i = 1; i < chunk_count; ++i) {
+      int c = static_cast<int>(static_cast<long>(constraints.size()) * i / chunk_count);
+      while (c > 0 && c < constraints.size() && constraints.sample[c] == constraints.sample[c - 1]) ++c;
+      bounds[i] = std::max(bounds[i - 1], c);
+    }
+    tbb::parallel_for(0, chunk_count, [&](int i) { aggregate(bounds[i], bounds[i + 1]); });
+  } else {
+    aggregate(0, constraints.size());
   }
   solution->displacement = Positions::Zero(vertices, 3);
   VectorMap D(solution->displacement.data(), 3 * vertices);
@@ -306,21 +311,19 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
   solution->level_motion.resize(n_ + 1);
   solution->levels.clear();
   Positions coarse_motion = Positions::Zero(hierarchy_->VertexCount(lo_), 3);  // W_i
-  // Data matrices of the levels: assembled on level hi, carried to the coarser ones one
-  // refinement step at a time, P_iᵀ N P_i = C(i)ᵀ (P_{i+1}ᵀ N P_{i+1}) C(i).
-  std::vector<Sparse> data(n_ + 1);
-  data[hi_] = DataMatrix(stencils_, M);
-  for (int level = hi_ - 1; level >= lo_; --level)
-    data[level] = Sparse(refinement3_[level].transpose() * Sparse(data[level + 1] * refinement3_[level]));
+  // Data matrices of the levels (block sums): accumulated on level hi, carried to the
+  // coarser ones one refinement step at a time, P_iᵀ N P_i = C(i)ᵀ (P_{i+1}ᵀ N P_{i+1}) C(i).
+  std::vector<std::vector<double>> data(n_ + 1);
+  data[hi_] = DataSums(stencils_, M);
+  for (int level = hi_ - 1; level >= lo_; --level) data[level] = CoarsenBlockSums(coarsening_[level], data[level + 1]);
   for (int level = lo_; level <= hi_; ++level) {
     const int unknowns = 3 * hierarchy_->VertexCount(level);
     const Sparse& P3 = prolongation3_[level];
     const geometry::SparseMatrix& level_limit = level_limit_[level];
-    Sparse A = std::move(data[level]);
     LevelSolveReport report;
     report.level = level;
     report.unknowns = unknowns;
-    report.data_stiffness = A.diagonal().sum() / unknowns;
+    report.data_stiffness = DataStiffness(level_matrix_[level], data[level]);
     Positions& delta = solution->level_motion[level];
     if (delta.rows() != hierarchy_->VertexCount(level))
       delta = Positions::Zero(hierarchy_->VertexCount(level), 3);
@@ -343,12 +346,11 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
           sample_rhs(s, 2) = h(s, 2) - (m6[2] * u0 + m6[4] * u1 + m6[5] * u2);
         }
       });
-      const Positions data_rhs = level_limit.transpose() * sample_rhs;
+      const Positions data_rhs = RowParallelProduct(level_limit_transpose_[level], sample_rhs);
       const Eigen::VectorXd rhs = ConstVectorMap(data_rhs.data(), unknowns) -
                                   report.smoothness_weight * (smoothness3_[level] * W);
       // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
-      A += report.data_stiffness * regularizer3_[level];
-      A.makeCompressed();
+      const Sparse A = AssembleLevelMatrix(level_matrix_[level], data[level], report.data_stiffness);
       Eigen::VectorXd solution_vector = x;
       const ConjugateGradientResult cg = SolveConjugateGradient(
           A, rhs, options_.cg_tolerance, options_.cg_max_iterations, &solution_vector);
@@ -359,7 +361,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       x.setZero();
     }
     D += P3 * x;
-    sample_motion += level_limit * delta;
+    sample_motion += RowParallelProduct(level_limit, delta);
     solution->cg_iterations += report.cg_iterations;
     solution->levels.push_back(report);
     if (level < hi_)

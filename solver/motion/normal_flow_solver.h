@@ -60,6 +60,7 @@
 #include "geometry/limit_evaluation.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/triangle_mesh.h"
+#include "solver/motion/level_matrices.h"
 #include "solver/motion/normal_flow_constraints.h"
 #include "solver/rigid/rigid_motion.h"
 
@@ -160,22 +161,22 @@ class NormalFlowSolver {
   // The limit surface of C(i) c is that of c, so a row of L_hi is level hi's own limit
   // stencil (the 1-ring of the face holding the sample, ~12 control points), not the union
   // of the finest stencil's ancestors; entries that cancel to rounding noise are dropped.
-  // The data matrix is assembled there once per solve (DataMatrix) and carried to the
-  // coarser levels by C(i)ᵀ · C(i); the finest level's (#V(n) ≫ #V(hi)) is never formed.
+  // The data matrix is accumulated there once per solve (DataSums) and carried to the
+  // coarser levels by C(i)ᵀ · C(i) (level_matrices.h); the finest level's (#V(n) ≫ #V(hi))
+  // is never formed.
   struct SampleStencils {
     geometry::SparseMatrix limit;        // L_hi, row-major
-    Sparse pattern;                      // pattern of L_hiᵀ L_hi (#V(hi) square), sorted
-    std::vector<int> mirror;             // per pattern entry (r, c): the entry (c, r)
+    SymmetricPattern pattern;            // of L_hiᵀ L_hi (#V(hi) square)
     // Per sample, per stencil pair p ≤ q: the pattern entry (min, max) of their columns.
     std::vector<int> pair_entry;
     std::vector<int> sample_pair_offset; // #S + 1 offsets into pair_entry
   };
   // Drops the rounding-noise entries of `limit` and builds the pair pattern.
   static SampleStencils MakeStencils(const geometry::SparseMatrix& limit);
-  // L_hiᵀ M L_hi = P_hiᵀ (Lᵀ M L) P_hi, interleaved (unknown 3v + axis), for per-sample
+  // The block sums (level_matrices.h) of L_hiᵀ M L_hi = P_hiᵀ (Lᵀ M L) P_hi for per-sample
   // symmetric 3×3 blocks M (#S×6: xx xy xz yy yz zz).
-  static Sparse DataMatrix(const SampleStencils& stencils,
-                           const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M);
+  static std::vector<double> DataSums(const SampleStencils& stencils,
+                                      const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M);
 
   const geometry::LoopHierarchy* hierarchy_;
   NormalFlowSolverOptions options_;
@@ -183,10 +184,11 @@ class NormalFlowSolver {
   geometry::SparseMatrix limit_;       // L, row-major
   SampleStencils stencils_;            // of level hi
   std::vector<geometry::SparseMatrix> level_limit_;  // L P_i (#S × #V(i)), by level lo..hi
-  std::vector<Sparse> refinement3_;    // C(i) ⊗ I3 (3#V(i+1) × 3#V(i)), by level lo..hi−1
+  std::vector<geometry::SparseMatrix> level_limit_transpose_;  // (L P_i)ᵀ, row-major
+  std::vector<geometry::SparseMatrix> coarsening_;  // block sums of level i+1 → i, by level lo..hi−1
+  std::vector<LevelMatrix> level_matrix_;  // CG matrix structure, by level lo..hi
   std::vector<Sparse> prolongation3_;  // P_i ⊗ I3 (3#V(n) × 3#V(i)), by level
   std::vector<Sparse> smoothness3_;    // U_iᵀ U_i ⊗ I3, by level
-  std::vector<Sparse> regularizer3_;   // smoothness (R/h_i)⁴ U_iᵀU_i ⊗ I3 + β_i I, by level
   std::vector<double> length_ratio4_;  // (R/h_i)⁴ by level
 };
 
