@@ -24,7 +24,6 @@ namespace subflow {
 namespace {
 
 namespace fs = std::filesystem;
-using test::RunSubflow;
 using test::TemporaryDirectory;
 
 const TemporaryDirectory& Scratch() {
@@ -33,17 +32,8 @@ const TemporaryDirectory& Scratch() {
 }
 const std::vector<std::string> kSmall = {"--base-faces", "120", "--levels", "2", "--window", "3", "--iterations", "4"};
 
-// The small deforming blob of reconstruct_command_test: 6 gray cameras, 3 frames.
 const fs::path& Dataset() {
-  static const fs::path dataset = [] {
-    const fs::path path = Scratch() / "blob";
-    const test::CommandResult run =
-        RunSubflow("synth blob --out '" + path.string() +
-                       "' --cameras 6 --frames 3 --width 160 --height 120 --subdivisions 4 --gray",
-                   Scratch().path());
-    EXPECT_EQ(run.exit_code, 0) << run.output();
-    return path;
-  }();
+  static const fs::path dataset = test::SynthSmallBlob(Scratch());
   return dataset;
 }
 
