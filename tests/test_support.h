@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "geometry/triangle_mesh.h"
@@ -92,6 +93,17 @@ inline CommandResult RunSubflow(const std::string& arguments,
   std::filesystem::remove(out);
   std::filesystem::remove(err);
   return run;
+}
+
+// The small deforming blob the reconstruct tests run on (6 gray cameras, 3 frames,
+// 160×120), written by `subflow synth` to <scratch>/blob.
+inline std::filesystem::path SynthSmallBlob(const TemporaryDirectory& scratch) {
+  const std::filesystem::path path = scratch / "blob";
+  const CommandResult run = RunSubflow(
+      "synth blob --out '" + path.string() + "' --cameras 6 --frames 3 --width 160 --height 120 --subdivisions 4 --gray",
+      scratch.path());
+  if (run.exit_code != 0) throw std::runtime_error("subflow synth failed: " + run.output());
+  return path;
 }
 #endif
 

@@ -23,15 +23,7 @@ const TemporaryDirectory& Scratch() {
   return scratch;
 }
 const fs::path& Dataset() {
-  static const fs::path dataset = [] {
-    const fs::path path = Scratch() / "blob";
-    const test::CommandResult run =
-        RunSubflow("synth blob --out '" + path.string() +
-                       "' --cameras 6 --frames 3 --width 160 --height 120 --subdivisions 4 --gray",
-                   Scratch().path());
-    EXPECT_EQ(run.exit_code, 0) << run.output();
-    return path;
-  }();
+  static const fs::path dataset = test::SynthSmallBlob(Scratch());
   return dataset;
 }
 const std::string kSmall = " --base-faces 120 --levels 2 --window 3 --iterations 4 ";
