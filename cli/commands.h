@@ -29,6 +29,8 @@ Command AddRefineCommand(CLI::App& app);      // cli/stage_commands.cpp
 Command AddRetrackCommand(CLI::App& app);     // cli/stage_commands.cpp
 Command AddSplitCommand(CLI::App& app);       // cli/stage_commands.cpp
 Command AddMergeCommand(CLI::App& app);       // cli/stage_commands.cpp
+Command AddPlanCommand(CLI::App& app);        // cli/plan_command.cpp
+Command AddRunPlanCommand(CLI::App& app);     // cli/plan_command.cpp
 Command AddReconstructCommand(CLI::App& app);  // cli/reconstruct_command.cpp
 Command AddExportCommand(CLI::App& app);       // cli/export_command.cpp
 Command AddImportCommand(CLI::App& app);       // cli/import_command.cpp
@@ -48,6 +50,8 @@ inline std::vector<AddCommandFunction> AllCommands() {
       AddRetrackCommand,
       AddSplitCommand,
       AddMergeCommand,
+      AddPlanCommand,
+      AddRunPlanCommand,
       AddReconstructCommand,
       AddExportCommand,
       AddImportCommand,

@@ -23,21 +23,16 @@ struct ReconstructArguments {
   std::string out;
   bool overwrite = false;
   bool resume = false;
-  bool no_refine = false;
-  std::string evidence = "auto";
-  solver::ReconstructionOptions options;
+  ReconstructionArguments stages;
 };
 
 void RunReconstruct(const ReconstructArguments& arguments) {
   const Stopwatch start;
-  solver::ReconstructionOptions options = arguments.options;
-  options.shape.silhouettes.source = vision::ParseEvidenceSource(arguments.evidence, "--evidence");
-  options.refine = !arguments.no_refine;
-  options.Check();
+  const solver::ReconstructionOptions options = arguments.stages.Options();
   const vision::Dataset dataset(arguments.dataset);
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite, arguments.resume);
   ProgressBar progress;
-  const std::string command = arguments.no_refine ? "reconstruct --no-refine" : "reconstruct";
+  const std::string command = arguments.stages.no_refine ? "reconstruct --no-refine" : "reconstruct";
   const nlohmann::json stages = output::RunReconstruction({command, arguments.out, arguments.overwrite, arguments.resume}, dataset,
                                                           options, arguments.resume, &progress, start);
   spdlog::info("reconstruct: written to {} in {:.1f} s (stages: {})", arguments.out, start.Seconds(), stages.dump());
@@ -54,16 +49,7 @@ Command AddReconstructCommand(CLI::App& app) {
   sub->add_flag("--resume", arguments->resume,
                 "Continue an interrupted run in --out: complete stage folders (OUT/stages/) written with the "
                 "same options are loaded instead of recomputed");
-  sub->add_flag("--no-refine", arguments->no_refine,
-                "Stop after motion initialization (no spatio-temporal stereo refinement)");
-  sub->add_flag("!--no-retrack", arguments->options.retrack,
-                "Keep the first motion pass (do not re-estimate trajectories on the refined shapes)");
-  sub->add_option("--retrack-weight", arguments->options.retrack_weight,
-                  "Blend of the second motion pass towards each frame's refined surface (0..1)")
-      ->capture_default_str();
-  AddShapeInitOptions(sub, &arguments->options.shape, &arguments->evidence);
-  AddMotionInitOptions(sub, &arguments->options.motion);
-  AddRefinementOptions(sub, &arguments->options.refinement);
+  AddReconstructionOptions(sub, &arguments->stages);
   return {sub, [arguments] { RunReconstruct(*arguments); }};
 }
 

@@ -25,6 +25,8 @@ namespace {
 struct StageArguments {
   std::string dataset;
   std::string from;  // the previous stage's folder (not for shape)
+  std::string seed;  // motion, retrack: the stage folder whose trajectories this range continues
+  std::string options_file;  // --options: every stage's options from a JSON file
   std::string out;
   bool overwrite = false;
   std::string evidence = "auto";
@@ -54,13 +56,14 @@ void CheckStageOptions(solver::Stage stage, const solver::ReconstructionOptions&
 void RunStageCommand(solver::Stage stage, const std::string& name, const StageArguments& arguments) {
   solver::ReconstructionOptions options = arguments.options;
   options.shape.silhouettes.source = vision::ParseEvidenceSource(arguments.evidence, "--evidence");
+  if (!arguments.options_file.empty()) options = output::ReadReconstructionOptions(arguments.options_file);
   CheckStageOptions(stage, options);
   const vision::Dataset dataset(arguments.dataset);
   std::optional<output::StageRecord> in;
   if (stage != solver::Stage::kShape) {
-    in = output::ReadStageFolder(arguments.from, solver::StageName(InputStage(stage)));
-    if (arguments.frame_count > 0)
-      in->state = in->state.Frames(arguments.first_frame, arguments.frame_count, arguments.from);
+    in = output::ReadStageFolder(arguments.from, solver::StageName(InputStage(stage)), arguments.first_frame,
+                                 arguments.frame_count);
+    if (!arguments.seed.empty()) output::SeedStageInput(&*in, arguments.seed);
   }
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
   ProgressBar progress;
@@ -79,6 +82,15 @@ Command AddStageCommand(CLI::App& app, solver::Stage stage, const std::string& n
         ->required()->check(CLI::ExistingDirectory);
     AddFramesOption(sub, &arguments->first_frame, &arguments->frame_count, false);
   }
+  sub->add_option("--options", arguments->options_file,
+                  "Every stage's options from a JSON file (as report.json's \"options\" of reconstruct; "
+                  "subflow plan writes one), instead of the flags")
+      ->check(CLI::ExistingFile);
+  if (stage == solver::Stage::kMotion || stage == solver::Stage::kRetrack)
+    sub->add_option("--seed", arguments->seed,
+                    "Stage folder (of this stage, an earlier range) whose trajectories this range continues: the "
+                    "frame both hold becomes the reference frame, with the seed's control points")
+        ->check(CLI::ExistingDirectory);
   switch (stage) {
     case solver::Stage::kShape:
       AddShapeInitOptions(sub, &arguments->options.shape, &arguments->evidence);
@@ -125,10 +137,10 @@ struct MergeArguments {
 
 void RunMerge(const MergeArguments& arguments) {
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
-  const output::StageRecord merged =
+  const nlohmann::json merged =
       output::MergeStageFolders({"merge", arguments.out, arguments.overwrite}, arguments.inputs, arguments.out);
-  spdlog::info("merge: {} stage folders, frames {}–{}, written to {}", arguments.inputs.size(),
-               merged.state.first_frame, merged.state.first_frame + merged.state.frame_count() - 1, arguments.out);
+  spdlog::info("merge: {} stage folders, frames {}, written to {}", arguments.inputs.size(), merged["frames"].dump(),
+               arguments.out);
 }
 
 }  // namespace

@@ -125,4 +125,25 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
                   "Temporal smoothness of the corrections")->capture_default_str();
 }
 
+solver::ReconstructionOptions ReconstructionArguments::Options() const {
+  solver::ReconstructionOptions result = options;
+  result.shape.silhouettes.source = vision::ParseEvidenceSource(evidence, "--evidence");
+  result.refine = !no_refine;
+  result.Check();
+  return result;
+}
+
+void AddReconstructionOptions(CLI::App* sub, ReconstructionArguments* arguments) {
+  sub->add_flag("--no-refine", arguments->no_refine,
+                "Stop after motion initialization (no spatio-temporal stereo refinement)");
+  sub->add_flag("!--no-retrack", arguments->options.retrack,
+                "Keep the first motion pass (do not re-estimate trajectories on the refined shapes)");
+  sub->add_option("--retrack-weight", arguments->options.retrack_weight,
+                  "Blend of the second motion pass towards each frame's refined surface (0..1)")
+      ->capture_default_str();
+  AddShapeInitOptions(sub, &arguments->options.shape, &arguments->evidence);
+  AddMotionInitOptions(sub, &arguments->options.motion);
+  AddRefinementOptions(sub, &arguments->options.refinement);
+}
+
 }  // namespace subflow::cli

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "solver/motion/motion_init.h"
+#include "solver/reconstruction.h"
 #include "solver/shape/shape_init.h"
 #include "solver/stereo/stereo_refinement.h"
 
@@ -31,5 +32,18 @@ void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options);
 // --refine-from, --refine-to, --window, --window-overlap, --rounds, --iterations,
 // --linear-solver, --threads, --samples-per-pixel, --max-cameras and the term weights.
 void AddRefinementOptions(CLI::App* app, solver::StereoRefinementOptions* options);
+
+// What `reconstruct` (and `plan`) run, as the command line gives it.
+struct ReconstructionArguments {
+  solver::ReconstructionOptions options;
+  std::string evidence = "auto";
+  bool no_refine = false;
+
+  // `options` with --evidence and --no-refine applied, checked (throws subflow::Error).
+  solver::ReconstructionOptions Options() const;
+};
+
+// --no-refine, --no-retrack, --retrack-weight and the options of every stage.
+void AddReconstructionOptions(CLI::App* app, ReconstructionArguments* arguments);
 
 }  // namespace subflow::cli

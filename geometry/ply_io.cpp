@@ -371,12 +371,12 @@ int FindProperty(const Element& element, std::initializer_list<const char*> name
   return -1;
 }
 
-template <class Body>
-TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes,
-                      const std::string& source, VertexProperties* properties) {
+// The header's "vertex" and "face" elements, after checking that every element's count
+// fits in the `data_bytes` that follow the header and that the mesh is not empty.
+void FindMeshElements(const Header& header, long long data_bytes, const std::string& source,
+                      const Element** vertex_element, const Element** face_element) {
   const Element* vertex = nullptr;
   const Element* face = nullptr;
-  const long long data_bytes = static_cast<long long>(bytes.size() - header.body_offset);
   for (const Element& element : header.elements) {
     if (element.name == "vertex") vertex = &element;
     if (element.name == "face") face = &element;
@@ -399,6 +399,17 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
     ThrowError(source, "element vertex", "count is 0 (expected a non-empty mesh)");
   if (face->count == 0)
     ThrowError(source, "element face", "count is 0 (expected a non-empty mesh)");
+
+  *vertex_element = vertex;
+  *face_element = face;
+}
+
+template <class Body>
+TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes,
+                      const std::string& source, VertexProperties* properties) {
+  const Element* vertex = nullptr;
+  const Element* face = nullptr;
+  FindMeshElements(header, static_cast<long long>(bytes.size() - header.body_offset), source, &vertex, &face);
 
   // Roles of the vertex properties: coordinate axis, extra column, or skipped list.
   std::vector<int> vertex_role(vertex->properties.size(), -1);  // 0..2 axis, 3+k extra k, -1 skip

@@ -1,5 +1,6 @@
 #include "output/stage_folder.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include "core/error.h"
@@ -54,6 +55,8 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
   report["stage_layout_version"] = kStageLayoutVersion;
   report["frames"] = {{"first", state.first_frame}, {"count", state.frame_count()}};
   report["reference_frame"] = state.reference_frame;
+  // The take's reference frame (shape initialization's), kept through ranges and seeds.
+  report["take_reference_frame"] = record.report.value("take_reference_frame", state.reference_frame);
   report["levels"] = hierarchy.finest_level();
   report["evidence"] = vision::ToString(state.evidence);
   report["image_scales"] = state.image_scales;
@@ -62,7 +65,8 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
 
 bool StageFolderComplete(const std::string& folder) { return fs::is_regular_file(ReportPath(folder)); }
 
-StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage) {
+StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage, int first_wanted,
+                            int count_wanted) {
   const std::string report_path = ReportPath(folder);
   if (!fs::is_directory(folder)) ThrowError(folder, "", "not a directory (expected a stage folder)");
   if (!StageFolderComplete(folder))
@@ -80,16 +84,27 @@ StageRecord ReadStageFolder(const std::string& folder, const std::string& expect
   if (!expected_stage.empty() && stage != expected_stage)
     reader.Fail("stage", "expected \"" + expected_stage + "\", found \"" + stage + "\"");
   const nlohmann::json& frames = reader.Required(report, "frames", "");
-  const int first = static_cast<int>(reader.Integer(reader.Required(frames, "first", "frames"), "frames.first", 0,
+  int first = static_cast<int>(reader.Integer(reader.Required(frames, "first", "frames"), "frames.first", 0,
                                                     1 << 30));
-  const int count = static_cast<int>(reader.Integer(reader.Required(frames, "count", "frames"), "frames.count", 1,
+  int count = static_cast<int>(reader.Integer(reader.Required(frames, "count", "frames"), "frames.count", 1,
                                                     1 << 30));
   const int levels = static_cast<int>(reader.Integer(reader.Required(report, "levels", ""), "levels", 0, 6));
 
+  const int reference = static_cast<int>(
+      reader.Integer(reader.Required(report, "reference_frame", ""), "reference_frame", first, first + count - 1));
+  const int take_reference = report.value("take_reference_frame", reference);
+  if (count_wanted > 0) {
+    if (first_wanted < first || first_wanted + count_wanted > first + count)
+      ThrowError(folder, "frames",
+                 "[" + std::to_string(first_wanted) + ", " + std::to_string(first_wanted + count_wanted) +
+                     ") is not inside the frames [" + std::to_string(first) + ", " + std::to_string(first + count) +
+                     ") of the stage folder");
+    first = first_wanted;
+    count = count_wanted;
+  }
   solver::StageState& state = record.state;
   state.first_frame = first;
-  state.reference_frame = static_cast<int>(
-      reader.Integer(reader.Required(report, "reference_frame", ""), "reference_frame", first, first + count - 1));
+  state.reference_frame = std::clamp(count_wanted > 0 ? take_reference : reference, first, first + count - 1);
   state.evidence = vision::ParseEvidenceSource(reader.String(reader.Required(report, "evidence", ""), "evidence"),
                                                report_path + ": evidence");
   state.image_scales = reader.Numbers(reader.Required(report, "image_scales", ""), -1, "image_scales");
@@ -106,6 +121,26 @@ StageRecord ReadStageFolder(const std::string& folder, const std::string& expect
   }
   state.Check(folder);
   return record;
+}
+
+void SeedStageInput(StageRecord* in, const std::string& seed) {
+  const nlohmann::json report = ReadJsonFile(ReportPath(seed), "a stage report (docs/stages.md)");
+  const int seed_first = report.at("frames").at("first").get<int>();
+  const int seed_end = seed_first + report.at("frames").at("count").get<int>();
+  solver::StageState& state = in->state;
+  const int first = std::max(seed_first, state.first_frame);
+  const int end = std::min(seed_end, state.first_frame + state.frame_count());
+  if (first >= end)
+    ThrowError(seed, "frames",
+               "shares no frame with the input's [" + std::to_string(state.first_frame) + ", " +
+                   std::to_string(state.first_frame + state.frame_count()) + ")");
+  const int frame = std::clamp(report.at("reference_frame").get<int>(), first, end - 1);
+  const StageRecord source = ReadStageFolder(seed, "", frame, 1);
+  if (source.state.base_mesh.F != state.base_mesh.F)
+    ThrowError(seed, "base_mesh.ply", "another connectivity than the input's");
+  state.reference_frame = frame;
+  state.control[frame - state.first_frame] = source.state.control.front();
+  in->report["seed"] = {{"folder", fs::absolute(seed).lexically_normal().string()}, {"frame", frame}};
 }
 
 }  // namespace subflow::output

@@ -42,9 +42,22 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
 // True when `folder`/report.json exists: the stage that wrote the folder finished.
 bool StageFolderComplete(const std::string& folder);
 
-// Reads a complete stage folder. Throws subflow::Error naming the file: no report.json
+// Reads a complete stage folder: all its frames, or, with count > 0, only dataset frames
+// [first, first + count) (a range of frames or a refinement window run alone; memory
+// then grows with the range, not with the folder), the reference frame moved to the frame
+// of the range nearest to it. Throws subflow::Error naming the file: no report.json
 // ("unfinished"), another layout version, a stage other than `expected_stage` (when not
-// empty), a missing frame file, control points of the wrong count.
-StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage = "");
+// empty), a range not inside the folder's frames, a missing frame file, control points
+// of the wrong count.
+StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage = "", int first = 0,
+                            int count = -1);
+
+// Seeds `in` (a motion or retrack stage's input) from the stage folder `seed`: the frame
+// both hold (the one nearest to seed's reference frame, when several) becomes the
+// reference frame, with seed's control points there, so that the stage's trajectories
+// continue seed's across the shared frame (chunks of a plan, docs/cluster.md). Records
+// {"folder", "frame"} as in->report["seed"]. Throws subflow::Error naming `seed` when the
+// folders share no frame or another connectivity.
+void SeedStageInput(StageRecord* in, const std::string& seed);
 
 }  // namespace subflow::output

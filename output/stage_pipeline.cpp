@@ -108,6 +108,8 @@ StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& 
       if (in->report.contains(key)) report[key] = in->report[key];
     for (Stage before : kStages)
       if (in->report.contains(StageSection(before))) report[StageSection(before)] = in->report[StageSection(before)];
+    if (in->report.contains("seed") && stage != Stage::kRefine) report["seed"] = in->report["seed"];
+    if (in->report.contains("take_reference_frame")) report["take_reference_frame"] = in->report["take_reference_frame"];
   }
   report["options"][StageSection(stage)] = OptionsOf(options, stage);
   report[StageSection(stage)] = section;
@@ -139,6 +141,18 @@ void WriteReconstruction(const CommandRun& run, const vision::Dataset& dataset, 
   report["total_seconds"] = timings["total"];
   WriteJsonFile((fs::path(run.out) / "report.json").string(), report);
   spdlog::info("{}", split.BriefReport());
+}
+
+solver::ReconstructionOptions ReadReconstructionOptions(const std::string& path) {
+  const nlohmann::json json = ReadJsonFile(path, "the options of every stage (report.json's \"options\")");
+  try {
+    solver::ReconstructionOptions options = json.get<solver::ReconstructionOptions>();
+    options.Check();
+    return options;
+  } catch (const nlohmann::json::exception& e) {
+    ThrowError(path, "options", std::string("expected every stage's options as report.json records them (") +
+                                    e.what() + ")");
+  }
 }
 
 std::string StageFolderOf(const std::string& out, Stage stage) {

@@ -55,6 +55,10 @@ nlohmann::json RunReconstruction(const CommandRun& run, const vision::Dataset& d
                                  const solver::ReconstructionOptions& options, bool resume, Progress* progress,
                                  const Stopwatch& since_start);
 
+// The options of every stage from `path`, a JSON object as report.json's "options" of
+// reconstruct (subflow plan writes one for its tasks). Throws subflow::Error naming it.
+solver::ReconstructionOptions ReadReconstructionOptions(const std::string& path);
+
 // The folder of `stage` inside a reconstruction's output directory: <out>/stages/<name>.
 std::string StageFolderOf(const std::string& out, solver::Stage stage);
 
@@ -62,8 +66,9 @@ std::string StageFolderOf(const std::string& out, solver::Stage stage);
 // that together cover a contiguous range) as one stage folder `folder`. A frame that
 // several inputs hold is taken from the one in which it lies farthest from the range's
 // ends (a refinement window's edge frames see one side only); on a tie, the earlier input.
-// Throws subflow::Error naming the input that does not fit.
-StageRecord MergeStageFolders(const CommandRun& run, const std::vector<std::string>& inputs,
+// Copies the files frame by frame (memory does not grow with the take). Returns the
+// merged report. Throws subflow::Error naming the input that does not fit.
+nlohmann::json MergeStageFolders(const CommandRun& run, const std::vector<std::string>& inputs,
                               const std::string& folder);
 
 }  // namespace subflow::output

@@ -21,6 +21,8 @@ packages=(
   # (python3-numpy: its glTF importer needs it), Chromium opens the viewer headless.
   blender python3-numpy
   chromium
+  # A single-node Slurm cluster for tests/cluster/slurm_plan_test.sh (slurmctld, slurmd, munge).
+  slurm-wlm munge
 )
 # node and npm (for the viewer's three.js bundle and the glTF validator): Debian's, unless
 # the machine already has a node.

@@ -59,20 +59,6 @@ void StageState::Check(const std::string& source) const {
                    std::to_string(first_frame + frame_count()) + ")");
 }
 
-StageState StageState::Frames(int first, int count, const std::string& source) const {
-  if (count < 1 || first < first_frame || first + count > first_frame + frame_count())
-    ThrowError(source, "frames",
-               "[" + std::to_string(first) + ", " + std::to_string(first + count) + ") is not inside the frames [" +
-                   std::to_string(first_frame) + ", " + std::to_string(first_frame + frame_count()) + ")");
-  StageState range = *this;
-  range.first_frame = first;
-  range.reference_frame = std::clamp(reference_frame, first, first + count - 1);
-  const int offset = first - first_frame;
-  range.hulls.assign(hulls.begin() + offset, hulls.begin() + offset + count);
-  range.control.assign(control.begin() + offset, control.begin() + offset + count);
-  return range;
-}
-
 geometry::Positions StageState::Surface(int i) const {
   return hierarchy->LimitPositions(hierarchy->finest_level()) * control.at(i);
 }

@@ -79,10 +79,6 @@ struct StageState {
   // Throws subflow::Error naming `source` when the sizes disagree (hulls and control per
   // frame, control rows against the hierarchy's finest level, the reference frame outside).
   void Check(const std::string& source) const;
-  // Dataset frames [first, first + count) of this state (a range of frames or a refinement
-  // window run alone); the reference frame moves to the frame of the range nearest to it.
-  // Throws subflow::Error naming `source` when the range is not inside the state's frames.
-  StageState Frames(int first, int count, const std::string& source) const;
   // The output surface of index i: the limit positions of the finest level's vertices.
   geometry::Positions Surface(int i) const;
 };

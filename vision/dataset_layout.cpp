@@ -181,6 +181,71 @@ cv::Mat ReadImageFile(const std::string& path, const Camera& camera) {
 
 namespace {
 
+// The videos/<camera>.<ext> of a dataset: their paths, sizes and the frame count.
+void ScanVideos(const fs::path& videos, DatasetLayout* out) {
+  DatasetLayout& layout = *out;
+  const std::vector<Camera>& cameras = layout.cameras;
+  layout.videos = true;
+  layout.video_paths.resize(cameras.size());
+  for (const auto& entry : fs::directory_iterator(videos)) {
+    if (Hidden(entry.path())) continue;
+    const std::string stem = entry.path().stem().string();
+    auto it = std::find_if(cameras.begin(), cameras.end(),
+                           [&](const Camera& camera) { return camera.name() == stem; });
+    if (it == cameras.end() || !entry.is_regular_file())
+      ThrowError(Str(entry.path()), "", "unknown camera video (expected videos/<camera>.<ext> for the "
+                                        "cameras of cameras.json: " + CameraList(cameras) + ")");
+    std::string& path = layout.video_paths[it - cameras.begin()];
+    if (!path.empty())
+      ThrowError(Str(entry.path()), "", "second video of camera \"" + stem + "\" (the first is " + path + ")");
+    path = Str(entry.path());
+  }
+  std::map<int, std::string> counts;  // reported frame count → a video with it
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    const std::string& path = layout.video_paths[c];
+    if (path.empty())
+      ThrowError(Str(videos / cameras[c].name()), "", "camera \"" + cameras[c].name() +
+                                                          "\" has no video (expected videos/" +
+                                                          cameras[c].name() + ".<ext>)");
+    cv::VideoCapture capture(path);
+    if (!capture.isOpened())
+      ThrowError(path, "", "unreadable video (expected a file OpenCV's VideoCapture reads)");
+    const int width = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_WIDTH));
+    const int height = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_HEIGHT));
+    if (width != cameras[c].width() || height != cameras[c].height())
+      ThrowError(path, "size", "expected " + SizeText(cameras[c].width(), cameras[c].height()) +
+                                   " (camera \"" + cameras[c].name() + "\" in cameras.json), got " +
+                                   SizeText(width, height));
+    const double reported = capture.get(cv::CAP_PROP_FRAME_COUNT);
+    if (reported > kMaxFrameCount && !layout.info.frame_count)
+      ThrowError(path, "frame count",
+                 "the video reports " + std::to_string(reported) + " frames, more than " +
+                     std::to_string(kMaxFrameCount) + "; give \"frame_count\" in cameras.json");
+    // A count OpenCV cannot know comes as 0 or negative; beyond int it is no count.
+    const int count = reported >= 1 && reported <= kMaxFrameCount ? static_cast<int>(reported) : 0;
+    if (layout.info.frame_count) {
+      if (count > 0 && count < *layout.info.frame_count)
+        ThrowError(path, "frame count", "expected at least frame_count = " +
+                                            std::to_string(*layout.info.frame_count) +
+                                            " frames (cameras.json), the video has " + std::to_string(count));
+    } else if (count <= 0) {
+      ThrowError(path, "frame count", "unknown (the container does not report it); give "
+                                      "\"frame_count\" in cameras.json");
+    }
+    counts[count] = path;
+  }
+  if (layout.info.frame_count) {
+    layout.frame_count = *layout.info.frame_count;
+  } else {
+    if (counts.size() > 1)
+      ThrowError(counts.rbegin()->second, "frame count",
+                 "expected every video to have the same number of frames, got " +
+                     std::to_string(counts.rbegin()->first) + " here and " +
+                     std::to_string(counts.begin()->first) + " in " + counts.begin()->second);
+    layout.frame_count = counts.begin()->first;
+  }
+}
+
 DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers) {
   DatasetLayout layout;
   layout.directory = directory;
@@ -206,65 +271,7 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
     for (std::size_t c = 0; c < cameras.size(); ++c)
       CheckFrames({frames[c]}, layout.frame_count, images, {cameras[c]}, layout.image_extensions[c], count_origin);
   } else if (fs::is_directory(videos)) {
-    layout.videos = true;
-    layout.video_paths.resize(cameras.size());
-    for (const auto& entry : fs::directory_iterator(videos)) {
-      if (Hidden(entry.path())) continue;
-      const std::string stem = entry.path().stem().string();
-      auto it = std::find_if(cameras.begin(), cameras.end(),
-                             [&](const Camera& camera) { return camera.name() == stem; });
-      if (it == cameras.end() || !entry.is_regular_file())
-        ThrowError(Str(entry.path()), "", "unknown camera video (expected videos/<camera>.<ext> for the "
-                                          "cameras of cameras.json: " + CameraList(cameras) + ")");
-      std::string& path = layout.video_paths[it - cameras.begin()];
-      if (!path.empty())
-        ThrowError(Str(entry.path()), "", "second video of camera \"" + stem + "\" (the first is " + path + ")");
-      path = Str(entry.path());
-    }
-    std::map<int, std::string> counts;  // reported frame count → a video with it
-    for (std::size_t c = 0; c < cameras.size(); ++c) {
-      const std::string& path = layout.video_paths[c];
-      if (path.empty())
-        ThrowError(Str(videos / cameras[c].name()), "", "camera \"" + cameras[c].name() +
-                                                            "\" has no video (expected videos/" +
-                                                            cameras[c].name() + ".<ext>)");
-      cv::VideoCapture capture(path);
-      if (!capture.isOpened())
-        ThrowError(path, "", "unreadable video (expected a file OpenCV's VideoCapture reads)");
-      const int width = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_WIDTH));
-      const int height = static_cast<int>(capture.get(cv::CAP_PROP_FRAME_HEIGHT));
-      if (width != cameras[c].width() || height != cameras[c].height())
-        ThrowError(path, "size", "expected " + SizeText(cameras[c].width(), cameras[c].height()) +
-                                     " (camera \"" + cameras[c].name() + "\" in cameras.json), got " +
-                                     SizeText(width, height));
-      const double reported = capture.get(cv::CAP_PROP_FRAME_COUNT);
-      if (reported > kMaxFrameCount && !layout.info.frame_count)
-        ThrowError(path, "frame count",
-                   "the video reports " + std::to_string(reported) + " frames, more than " +
-                       std::to_string(kMaxFrameCount) + "; give \"frame_count\" in cameras.json");
-      // A count OpenCV cannot know comes as 0 or negative; beyond int it is no count.
-      const int count = reported >= 1 && reported <= kMaxFrameCount ? static_cast<int>(reported) : 0;
-      if (layout.info.frame_count) {
-        if (count > 0 && count < *layout.info.frame_count)
-          ThrowError(path, "frame count", "expected at least frame_count = " +
-                                              std::to_string(*layout.info.frame_count) +
-                                              " frames (cameras.json), the video has " + std::to_string(count));
-      } else if (count <= 0) {
-        ThrowError(path, "frame count", "unknown (the container does not report it); give "
-                                        "\"frame_count\" in cameras.json");
-      }
-      counts[count] = path;
-    }
-    if (layout.info.frame_count) {
-      layout.frame_count = *layout.info.frame_count;
-    } else {
-      if (counts.size() > 1)
-        ThrowError(counts.rbegin()->second, "frame count",
-                   "expected every video to have the same number of frames, got " +
-                       std::to_string(counts.rbegin()->first) + " here and " +
-                       std::to_string(counts.begin()->first) + " in " + counts.begin()->second);
-      layout.frame_count = counts.begin()->first;
-    }
+    ScanVideos(videos, &layout);
   } else {
     ThrowError(directory, "images/", "missing (expected images/<camera>/<frame>.png or videos/<camera>.<ext>)");
   }

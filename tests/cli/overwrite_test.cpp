@@ -126,6 +126,9 @@ const std::map<std::string, const WritingCommand*>& Commands() {
   static const WritingCommand merge{
       true, [](const fs::path& out) { return "merge " + Quoted(TinyStage("motion")) + " --out " + Quoted(out); },
       true};
+  static const WritingCommand plan{
+      true, [](const fs::path& out) { return "plan " + Quoted(TinyDataset()) + " --chunk 2 --out " + Quoted(out); },
+      true};
   static const WritingCommand reconstruct{
       true, [](const fs::path& out) { return "reconstruct " + Quoted(TinyDataset()) + " --out " + Quoted(out) + HullOptions(); },
       false};
@@ -151,7 +154,8 @@ const std::map<std::string, const WritingCommand*>& Commands() {
       {"check", nullptr},  // prints its figures (text or --json) on stdout only
       {"subdivide", &subdivide}, {"eval", &eval}, {"synth", &synth}, {"hull", &hull},
       {"shape", &shape}, {"motion", &motion}, {"refine", &refine}, {"retrack", &retrack}, {"split", &split},
-      {"merge", &merge},
+      {"merge", &merge}, {"plan", &plan},
+      {"run-plan", nullptr},  // writes only the tasks' folders of its plan (each task with --overwrite)
       {"reconstruct", &reconstruct}, {"export", &export_glb}, {"import", &import_qualisys}, {"render", &render},
       {"view", &view}};
   return commands;
