@@ -120,11 +120,11 @@ void RunSplit(const SplitArguments& arguments) {
   const vision::Dataset dataset(arguments.dataset);
   const output::StageRecord last = output::ReadStageFolder(arguments.from);
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  // A named copy: items() of the temporary value() returns would dangle in the loop.
+  const nlohmann::json options = last.report.value("options", nlohmann::json::object());
   nlohmann::json stages = nlohmann::json::object();
-  for (const auto& [section, ignored] : last.report.value("options", nlohmann::json::object()).items())
-    stages[section] = "loaded";
-  output::WriteReconstruction({"split", arguments.out, arguments.overwrite}, dataset,
-                              last.report.value("options", nlohmann::json::object()), last, stages, start);
+  for (const auto& [section, ignored] : options.items()) stages[section] = "loaded";
+  output::WriteReconstruction({"split", arguments.out, arguments.overwrite}, dataset, options, last, stages, start);
   spdlog::info("split: {} frames written to {} in {:.1f} s", last.state.frame_count(), arguments.out,
                start.Seconds());
 }

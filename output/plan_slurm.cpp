@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
-#include "output/output_file.h"
+#include "core/atomic_file.h"
 #include "output/plan.h"
 
 namespace subflow::output {
@@ -30,7 +30,7 @@ int TaskMemoryMiB(const std::string& directory, const nlohmann::json& task, int 
 }
 
 void WriteText(const fs::path& path, const std::string& text, bool executable) {
-  OutputFile file(path.string());
+  AtomicFile file(path.string());
   file.stream() << text;
   file.Commit();
   if (executable)

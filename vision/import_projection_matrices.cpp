@@ -26,7 +26,8 @@ std::string Trim(const std::string& text) {
 
 // Size of the image at `path`, or of the image called <stem>.<ext> in `folder`.
 bool ImageSize(const fs::path& path, int* width, int* height) {
-  if (!fs::is_regular_file(path)) return false;
+  std::error_code error;  // a name too long for the filesystem is no image, not a crash
+  if (!fs::is_regular_file(path, error)) return false;
   const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (image.empty()) return false;
   *width = image.cols;
