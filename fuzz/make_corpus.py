@@ -157,6 +157,17 @@ def main():
     write("calibration_fuzzer", "panoptic_json", tree([("calibration.json", json.dumps({"cameras": [
         {"name": "00_00", "type": "hd", "resolution": [64, 48], "K": [[50, 0, 32], [0, 50, 24], [0, 0, 1]],
          "distCoef": [0.01, 0, 0, 0, 0], "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "t": [[0], [0], [200]]}]}))]))
+    # COLMAP's binary model (cameras.bin, images.bin), little-endian as COLMAP writes it.
+    cameras_bin = struct.pack("<Q", 2)
+    cameras_bin += struct.pack("<IiQQ4d", 1, 1, 64, 48, 50, 52, 32, 24)  # PINHOLE
+    cameras_bin += struct.pack("<IiQQ4d", 2, 2, 64, 48, 50, 32, 24, 0.01)  # SIMPLE_RADIAL
+    images_bin = struct.pack("<Q", 2)
+    images_bin += struct.pack("<I4d3dI", 1, 1, 0, 0, 0, 0, 0, 2, 1) + b"cam00/000000.png\0"
+    images_bin += struct.pack("<Q", 1) + struct.pack("<ddq", 10, 20, -1)
+    images_bin += struct.pack("<I4d3dI", 2, 0.7071, 0, 0.7071, 0, 0.1, 0, 2, 2) + b"cam01/000000.png\0"
+    images_bin += struct.pack("<Q", 0)
+    # (without tree()'s last newline: the last block runs to the end of the seed)
+    write("calibration_fuzzer", "colmap_binary", tree([("cameras.bin", cameras_bin), ("images.bin", images_bin)])[:-1])
     # Qualisys .qca.txt (XML, QTM's 1/64-pixel units) and EasyMocap intri.yml / extri.yml.
     fov = ' bottom="767" left="0" right="1023" top="0"/>\n'
     write("calibration_fuzzer", "qualisys_qca", tree([("Calib.qca.txt",

@@ -131,6 +131,7 @@ std::vector<Reader> Readers() {
       {"obj_fuzzer/tetra_relative.obj", "mesh.obj", mesh("mesh.obj")},
       {"obj_fuzzer/lshape_ngon.obj", "mesh.obj", mesh("mesh.obj")},
       {"calibration_fuzzer/colmap", "", calibration("colmap", "")},
+      {"calibration_fuzzer/colmap_binary", "", calibration("colmap", "")},
       {"calibration_fuzzer/dtu_folder", "", calibration("matrices", "")},
       {"calibration_fuzzer/pose2sim_toml", "", calibration("toml", "Calib.toml")},
       {"calibration_fuzzer/panoptic_json", "", calibration("panoptic", "calibration.json")},
