@@ -128,7 +128,7 @@ def main():
             files.append(("masks/%s/%06d.png" % (cam, frame), png(w, h, 1, 8, lambda x, y, c: 255 if 2 < x < 6 else 0)))
         files.append(("background/%s.png" % cam, png(w, h, channels, 8, lambda x, y, c: 10)))
     write("dataset_layout_fuzzer", "images_masks_background", tree(files))
-    files = [("cameras.json", cameras_json(["a"], w, h, bounds=False))]
+    files = [("cameras.json", cameras_json(["a"], w, h, bounds=True))]
     files += [("images/a/%06d.png" % f, png(w, h, 4)) for f in range(3)]
     files += [("groundtruth/mesh/%06d.ply" % f, ply_ascii(TETRA_V, TETRA_F)) for f in range(3)]
     write("dataset_layout_fuzzer", "rgba_groundtruth", tree(files))
