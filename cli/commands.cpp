@@ -1,5 +1,6 @@
 #include "cli/commands.h"
 
+#include <filesystem>
 #include <iostream>
 
 #include <spdlog/spdlog.h>
@@ -58,6 +59,12 @@ int RunSelected(const std::vector<Command>& commands, bool verbose) {
       return 128 + e.signal_number();
     } catch (const subflow::Error& e) {
       std::cerr << "subflow " << name << ": error: " << e.what() << "\n";
+      return 1;
+    } catch (const std::filesystem::filesystem_error& e) {
+      // The file system refused a path (a link loop, a name too long, no permission):
+      // the user's input, not a bug. Said as every error is: the path, then the reason.
+      std::cerr << "subflow " << name << ": error: " << e.path1().string()
+                << (e.path2().empty() ? "" : " → " + e.path2().string()) << ": " << e.code().message() << "\n";
       return 1;
     } catch (const std::exception& e) {
       std::cerr << "subflow " << name << ": internal error: " << e.what() << "\n";
