@@ -68,7 +68,9 @@ void ReadMeshFinite(const fs::path& path) {
 }
 
 void ReadCalibrationFinite(const std::string& format, const fs::path& source) {
-  for (const vision::CalibratedCamera& camera : vision::ReadCalibration(format, source.string()).cameras) {
+  vision::CalibrationReadOptions options;
+  options.colmap_names = "folder";  // the seeds' images are <camera>/<frame>.png
+  for (const vision::CalibratedCamera& camera : vision::ReadCalibration(format, source.string(), options).cameras) {
     RequireFinite(camera.K, camera.name + " K");
     RequireFinite(camera.R, camera.name + " R");
     RequireFinite(camera.t, camera.name + " t");
@@ -140,7 +142,9 @@ std::vector<Reader> Readers() {
       {"projection_matrix_fuzzer/middlebury", "", calibration("middlebury", "scene_par.txt")},
       {"colmap_text_fuzzer/three_models", "",
        [](const fs::path& root) {
-         for (const vision::Camera& camera : vision::ReadColmapTextModel(root.string())) RequireFinite(camera);
+         vision::ColmapImportOptions options;
+         options.name_from = vision::ColmapImportOptions::NameFrom::kParentFolder;
+         for (const vision::Camera& camera : vision::ReadColmapTextModel(root.string(), options)) RequireFinite(camera);
        }},
       {"dataset_layout_fuzzer/images_masks_background", "", ReadDatasetFinite},
       {"dataset_layout_fuzzer/rgba_groundtruth", "", ReadDatasetFinite},
