@@ -83,11 +83,14 @@ const Inputs& MadeInputs() {
   return inputs;
 }
 
+// An output path in the scratch folder, quoted (the commands run in the test's folder).
+std::string Out(const std::string& name) { return Quoted(Scratch() / name); }
+
 std::map<std::string, Case> Cases(const Inputs& in) {
   const std::string dataset = Quoted(in.dataset), result = Quoted(in.result);
   const std::string shape = Quoted(in.result / "stages" / "shape"), motion = Quoted(in.result / "stages" / "motion");
   return {
-      {"synth", {"synth sphere --out o_synth", "o_synth/report.json",
+      {"synth", {"synth sphere --out " + Out("o_synth"), "o_synth/report.json",
                  {{"--overwrite", ""}, {"--rig", "dome"}, {"--cameras", "4"}, {"--width", "64"}, {"--height", "48"},
                   {"--frames", "2"}, {"--subdivisions", "3"}, {"--seed", "7"}, {"--noise", "0.013"},
                   {"--focal", "123"}, {"--distance", "0.77"}, {"--distortion", "-0.11,0.02,0,0,0"},
@@ -95,37 +98,46 @@ std::map<std::string, Case> Cases(const Inputs& in) {
                   {"--supersample", "2"}, {"--video", "mp4"}, {"--gray", ""}, {"--start-frame", "1"},
                   {"--voxel", "0.0037"}, {"--color-cameras", "2"}, {"--color-every", "3"}, {"--no-masks", ""},
                   {"--no-background", ""}, {"--background", "texture"}}}},
-      {"subdivide", {"subdivide " + Quoted(in.result / "base_mesh.ply") + " --out o_sub.ply", "o_sub.ply.report.json",
+      {"subdivide", {"subdivide " + Quoted(in.result / "base_mesh.ply") + " --out " + Out("o_sub.ply"), "o_sub.ply.report.json",
                      {{"--levels", "2"}, {"--limit", ""}, {"--overwrite", ""}}}},
-      {"eval", {"eval " + dataset + " " + result + " --json o_eval.json", "o_eval.json",
+      {"eval", {"eval " + dataset + " " + result + " --json " + Out("o_eval.json"), "o_eval.json",
                 {{"--overwrite", ""}, {"--threshold", "0.0031"}, {"--samples", "1234"}, {"--min-views", "3"},
                  {"--visibility-tolerance", "0.0017"}, {"--hull", ""}}}},
-      {"export", {"export " + result + " --format glb --out o_export.glb", "o_export.glb.report.json",
+      {"export", {"export " + result + " --format glb --out " + Out("o_export.glb"), "o_export.glb.report.json",
                   {{"--overwrite", ""}, {"--dataset", dataset}, {"--fps", "17"}, {"--color", "flow"}, {"--up", "-y"},
                    {"--no-normals", ""}, {"--no-sparse", ""}}}},
-      {"render", {"render " + result + " --out o_render", "o_render/report.json",
+      {"render", {"render " + result + " --out " + Out("o_render"), "o_render/report.json",
                   {{"--overwrite", ""}, {"--dataset", dataset}, {"--fps", "13"}, {"--frames", "2"}, {"--views", "2"},
                    {"--elevation", "23"}, {"--view-width", "64"}, {"--view-height", "48"}, {"--turntable-frame", "1"},
                    {"--no-overlays", ""}, {"--no-textured", ""}, {"--no-dataset", ""}, {"--mp4", ""}}}},
-      {"view", {"view " + result + " --out o_view.html", "o_view.html.report.json",
+      {"view", {"view " + result + " --out " + Out("o_view.html"), "o_view.html.report.json",
                 {{"--overwrite", ""}, {"--dataset", dataset}, {"--fps", "19"}, {"--stride", "2"},
                  {"--max-megabytes", "7"}, {"--no-texture", ""}}}},
-      {"shape", {"shape " + dataset + " --out o_shape", "o_shape/report.json",
+      {"shape", {"shape " + dataset + " --out " + Out("o_shape"), "o_shape/report.json",
                  {{"--overwrite", ""}, {"--evidence", "background"}, {"--levels", "1"}, {"--base-faces", "60"},
                   {"--reference-frame", "1"}, {"--first-frame", "0"}, {"--frames", "2"}, {"--resolution", "28"},
                   {"--min-cameras", "3"}, {"--max-misses", "1"}, {"--evidence-threshold", "0.21"},
                   {"--footprint-margin", "1.7"}, {"--lambda", "0.0021"}, {"--motion-window", "1"},
                   {"--motion-threshold", "0.31"}, {"--background-threshold", "0.071"}, {"--options", ""}}}},
-      {"motion", {"motion " + dataset + " --from " + shape + " --out o_motion", "o_motion/report.json",
+      {"motion", {"motion " + dataset + " --from " + shape + " --out " + Out("o_motion"), "o_motion/report.json",
                   {{"--overwrite", ""}, {"--frames", "0:2"}, {"--hull-weight", "0.41"},
                    {"--motion-smoothness", "0.0041"}, {"--seed", ""}, {"--options", ""}}}},
-      {"split", {"split " + dataset + " --from " + motion + " --out o_split", "o_split/report.json",
+      {"split", {"split " + dataset + " --from " + motion + " --out " + Out("o_split"), "o_split/report.json",
                  {{"--overwrite", ""}}}},
-      {"merge", {"merge " + motion + " --out o_merge", "o_merge/report.json", {{"--overwrite", ""}}}},
-      {"plan", {"plan " + dataset + " --out o_plan", "o_plan/plan.json",
+      {"merge", {"merge " + motion + " --out " + Out("o_merge"), "o_merge/report.json", {{"--overwrite", ""}}}},
+      {"plan", {"plan " + dataset + " --out " + Out("o_plan"), "o_plan/plan.json",
                 {{"--overwrite", ""}, {"--chunk", "2"}, {"--overlap", "1"}, {"--memory", "3000"}, {"--slurm", ""},
-                 {"--retrack-weight", "0.31"}, {"--hull-weight", "0.41"}}}},
-      {"import", {"import middlebury " + Quoted(in.calibration) + " --images " + Quoted(in.images) + " --out o_import",
+                 {"--retrack-weight", "0.31"}, {"--hull-weight", "0.41"}, {"--no-refine", ""}, {"--no-retrack", ""},
+                 {"--evidence", "background"}, {"--levels", "1"}, {"--base-faces", "60"}, {"--reference-frame", "1"},
+                 {"--first-frame", "0"}, {"--frames", "3"}, {"--resolution", "28"}, {"--min-cameras", "3"},
+                 {"--max-misses", "1"}, {"--evidence-threshold", "0.21"}, {"--footprint-margin", "1.7"},
+                 {"--lambda", "0.0021"}, {"--motion-window", "1"}, {"--motion-threshold", "0.31"},
+                 {"--background-threshold", "0.071"}, {"--motion-smoothness", "0.0041"}, {"--refine-from", "1"},
+                 {"--refine-to", "1"}, {"--window", "4"}, {"--window-overlap", "1"}, {"--rounds", "2"},
+                 {"--iterations", "3"}, {"--linear-solver", "DENSE_QR"}, {"--threads", "1"},
+                 {"--samples-per-pixel", "0.5"}, {"--max-cameras", "4"}, {"--temporal-weight", "0.5"},
+                 {"--silhouette-weight", "0.1"}, {"--membrane-weight", "0.2"}, {"--temporal-smoothness", "0.2"}}}},
+      {"import", {"import middlebury " + Quoted(in.calibration) + " --images " + Quoted(in.images) + " --out " + Out("o_import"),
                   "o_import/report.json",
                   {{"--overwrite", ""}, {"--units", "mm"}, {"--floor", "none"}, {"--link", "copy"},
                    {"--frames", "1"}}}},
@@ -135,6 +147,7 @@ std::map<std::string, Case> Cases(const Inputs& in) {
 // Flags a case leaves out, with the reason: they need inputs of another kind, or exclude
 // a flag the case sets. Each is still checked to be recorded (null or its default).
 const std::map<std::string, std::set<std::string>> kNotSet = {
+    {"synth", {"--gray"}},               // excludes --color-cameras
     {"shape", {"--options"}},            // every option from a file instead of the flags
     {"motion", {"--seed", "--options"}},  // an earlier range's folder; a file of options
     {"render", {"--no-dataset"}},       // excludes --dataset
