@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "vision/import_toml.h"
 
 namespace subflow::vision {
@@ -111,7 +112,7 @@ Calibration ParseEasyMocapCalibration(const std::string& intri_yml, const std::s
 }
 
 Calibration ReadEasyMocapCalibration(const std::string& path) {
-  const fs::path folder = fs::is_directory(path) ? fs::path(path) : fs::path(path).parent_path();
+  const fs::path folder = IsDirectory(path) ? fs::path(path) : fs::path(path).parent_path();
   const std::string intri = (folder / "intri.yml").string(), extri = (folder / "extri.yml").string();
   return ParseEasyMocapCalibration(ReadCalibrationFile(intri, "EasyMocap's intri.yml"),
                                    ReadCalibrationFile(extri, "EasyMocap's extri.yml"), intri, extri);
