@@ -20,27 +20,44 @@ cv::FileStorage Open(const std::string& text, const std::string& source) {
     return storage;
   } catch (const cv::Exception& e) {
     ThrowError(source, "", "cannot parse (expected OpenCV FileStorage YAML): " + e.msg);
+  } catch (const std::exception& e) {  // the parser also lets std::length_error and the like out
+    ThrowError(source, "", std::string("cannot parse (expected OpenCV FileStorage YAML): ") + e.what());
   }
+}
+
+// storage[key]; OpenCV throws when the document's top level is not a map.
+cv::FileNode Node(const cv::FileStorage& storage, const std::string& key, const std::string& source) {
+  try {
+    return storage[key];
+  } catch (const cv::Exception& e) {
+    ThrowError(source, key, "cannot look up (expected a YAML map at the top level): " + e.msg);
+  }
+}
+
+// The matrix stored at `node` (an !!opencv-matrix), as doubles.
+cv::Mat ReadMat(const cv::FileNode& node, const std::string& key, const std::string& source) {
+  cv::Mat mat;
+  try {
+    node >> mat;
+    mat.convertTo(mat, CV_64F);
+  } catch (const cv::Exception& e) {
+    ThrowError(source, key, "expected an !!opencv-matrix: " + e.msg);
+  }
+  return mat;
 }
 
 // The matrix at `key` with `rows`×`cols` (or the transposed shape) doubles.
 Eigen::MatrixXd Matrix(const cv::FileStorage& storage, const std::string& key, int rows, int cols,
                        const std::string& source, bool required = true) {
-  const cv::FileNode node = storage[key];
+  const cv::FileNode node = Node(storage, key, source);
   if (node.empty()) {
     if (required) ThrowError(source, key, "missing (expected a " + std::to_string(rows) + "×" + std::to_string(cols) + " !!opencv-matrix)");
     return Eigen::MatrixXd();
   }
-  cv::Mat mat;
-  try {
-    node >> mat;
-  } catch (const cv::Exception& e) {
-    ThrowError(source, key, "expected an !!opencv-matrix: " + e.msg);
-  }
+  const cv::Mat mat = ReadMat(node, key, source);
   if (mat.empty() || mat.channels() != 1 || !((mat.rows == rows && mat.cols == cols) || (mat.rows == cols && mat.cols == rows)))
     ThrowError(source, key, "expected a " + std::to_string(rows) + "×" + std::to_string(cols) + " matrix, got " +
                                 std::to_string(mat.rows) + "×" + std::to_string(mat.cols));
-  mat.convertTo(mat, CV_64F);
   Eigen::MatrixXd out(mat.rows, mat.cols);
   for (int r = 0; r < mat.rows; ++r)
     for (int c = 0; c < mat.cols; ++c) {
@@ -51,7 +68,7 @@ Eigen::MatrixXd Matrix(const cv::FileStorage& storage, const std::string& key, i
 }
 
 std::vector<std::string> Names(const cv::FileStorage& storage, const std::string& source) {
-  const cv::FileNode node = storage["names"];
+  const cv::FileNode node = Node(storage, "names", source);
   if (!node.isSeq() || node.size() == 0) ThrowError(source, "names", "missing (expected a list of camera names)");
   std::vector<std::string> names;
   for (const cv::FileNode& item : node) {
@@ -63,7 +80,7 @@ std::vector<std::string> Names(const cv::FileStorage& storage, const std::string
 }
 
 int OptionalInt(const cv::FileStorage& storage, const std::string& key, const std::string& source) {
-  const cv::FileNode node = storage[key];
+  const cv::FileNode node = Node(storage, key, source);
   if (node.empty()) return 0;
   if (!node.isInt() && !node.isReal()) ThrowError(source, key, "expected an integer");
   const double value = node.real();
@@ -87,12 +104,11 @@ Calibration ParseEasyMocapCalibration(const std::string& intri_yml, const std::s
     camera.K = Matrix(intri, "K_" + name, 3, 3, intri_source);
     Eigen::MatrixXd d = Matrix(intri, "dist_" + name, 1, 5, intri_source, false);
     if (d.size() == 0) {
-      const cv::FileNode node = intri["dist_" + name].empty() ? intri["D_" + name] : intri["dist_" + name];
-      cv::Mat mat;
-      if (!node.empty()) node >> mat;
+      const std::string key = Node(intri, "dist_" + name, intri_source).empty() ? "D_" + name : "dist_" + name;
+      const cv::FileNode node = Node(intri, key, intri_source);
+      const cv::Mat mat = node.empty() ? cv::Mat() : ReadMat(node, key, intri_source);
       if (mat.total() != 4 && mat.total() != 5 && mat.total() != 8)
-        ThrowError(intri_source, "dist_" + name, "missing or not 4, 5 or 8 values (k1 k2 p1 p2 [k3 [k4 k5 k6]])");
-      mat.convertTo(mat, CV_64F);
+        ThrowError(intri_source, key, "missing or not 4, 5 or 8 values (k1 k2 p1 p2 [k3 [k4 k5 k6]])");
       d.resize(1, mat.total());
       for (int i = 0; i < static_cast<int>(mat.total()); ++i) d(0, i) = mat.at<double>(i);
     }
