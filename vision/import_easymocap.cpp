@@ -34,10 +34,21 @@ cv::FileNode Node(const cv::FileStorage& storage, const std::string& key, const 
   }
 }
 
-// The matrix stored at `node` (an !!opencv-matrix), as doubles.
+// The matrix stored at `node` (an !!opencv-matrix), as doubles. Its rows and cols are
+// checked against its data before OpenCV allocates them (a calibration matrix is small).
 cv::Mat ReadMat(const cv::FileNode& node, const std::string& key, const std::string& source) {
+  constexpr int kMaxSide = 64;
   cv::Mat mat;
   try {
+    if (!node.isMap()) ThrowError(source, key, "expected an !!opencv-matrix (rows, cols, dt, data)");
+    const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
+    if (!rows.isInt() || !cols.isInt() || !data.isSeq())
+      ThrowError(source, key, "expected an !!opencv-matrix with integer rows and cols and a data list");
+    const int r = static_cast<int>(rows), c = static_cast<int>(cols);
+    if (r < 1 || c < 1 || r > kMaxSide || c > kMaxSide || static_cast<std::size_t>(r) * c != data.size())
+      ThrowError(source, key, "expected rows and cols in 1.." + std::to_string(kMaxSide) +
+                                  " with rows × cols values in data, got " + std::to_string(r) + "×" +
+                                  std::to_string(c) + " and " + std::to_string(data.size()) + " values");
     node >> mat;
     mat.convertTo(mat, CV_64F);
   } catch (const cv::Exception& e) {
