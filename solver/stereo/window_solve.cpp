@@ -5,6 +5,7 @@
 #include <memory>
 
 #include <ceres/ceres.h>
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include "core/stopwatch.h"
@@ -104,10 +105,13 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
     ceres::Solve(options.solver.ToCeres(), &problem, &summary);
     solution.solver_seconds = solve_start.Seconds();
     solution.iterations = static_cast<int>(summary.iterations.size());
+    std::string costs;
+    for (const ceres::IterationSummary& iteration : summary.iterations)
+      costs += fmt::format("{}{:.4g}{}", costs.empty() ? "" : " ", iteration.cost, iteration.step_is_successful ? "" : "✗");
     spdlog::debug("refinement level {} frames {}–{}: {}; jacobians {:.2f} s, residuals {:.2f} s, "
-                  "linear solver {:.2f} s", window.level, window.first, window.last, summary.BriefReport(),
-                  summary.jacobian_evaluation_time_in_seconds, summary.residual_evaluation_time_in_seconds,
-                  summary.linear_solver_time_in_seconds);
+                  "linear solver {:.2f} s; cost per iteration {}", window.level, window.first, window.last,
+                  summary.BriefReport(), summary.jacobian_evaluation_time_in_seconds,
+                  summary.residual_evaluation_time_in_seconds, summary.linear_solver_time_in_seconds, costs);
   }
   views.PrepareForEvaluation(false, true);  // at the solution Ceres wrote back
   Evaluate(problem, stereo, true, options.silhouette_weight, frames, &ncc_after, &ncc_count);
