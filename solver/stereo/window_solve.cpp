@@ -108,8 +108,9 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
     std::string costs;
     for (const ceres::IterationSummary& iteration : summary.iterations)
       costs += fmt::format("{}{:.4g}{}", costs.empty() ? "" : " ", iteration.cost, iteration.step_is_successful ? "" : "✗");
-    spdlog::debug("refinement level {} frames {}–{}: {}; jacobians {:.2f} s, residuals {:.2f} s, "
-                  "linear solver {:.2f} s; cost per iteration {}", window.level, window.first, window.last,
+    spdlog::debug("refinement level {} frames {}–{}: {} residuals in {} blocks, {} views; {}; jacobians {:.2f} s, "
+                  "residuals {:.2f} s, linear solver {:.2f} s; cost per iteration {}", window.level, window.first,
+                  window.last, problem.NumResiduals(), problem.NumResidualBlocks(), views.size(),
                   summary.BriefReport(), summary.jacobian_evaluation_time_in_seconds,
                   summary.residual_evaluation_time_in_seconds, summary.linear_solver_time_in_seconds, costs);
   }
