@@ -80,6 +80,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--window-overlap", {"1", "/options/refinement/window_overlap", 1}},
       {"--rounds", {"2", "/options/refinement/rounds", 2}},
       {"--iterations", {"3", "/options/refinement/solver/max_iterations", 3}},
+      {"--function-tolerance", {"0.01", "/options/refinement/solver/function_tolerance", 0.01}},
       {"--linear-solver", {"DENSE_QR", "/options/refinement/solver/linear_solver", "dense_qr"}},
       {"--threads", {"1", "/options/refinement/solver/threads", 1}},
       {"--samples-per-pixel", {"0.5", "/options/refinement/samples_per_pixel", 0.5}},
