@@ -41,9 +41,14 @@ std::set<std::string> Listed(const std::string& arguments, bool commands = false
     for (std::sregex_iterator it(text.begin(), text.end(), line), end; it != end; ++it) names.insert((*it)[1].str());
     return names;
   }
-  const std::regex flag("(^|[ ,])(--[a-z][a-z0-9-]*)");
-  for (std::sregex_iterator it(help.out.begin(), help.out.end(), flag), end; it != end; ++it)
-    names.insert((*it)[2].str());
+  // Option lines only ("  -o,--out TEXT  …"): a description may name another command's flag.
+  const std::regex option_line("\n  ((?:-{1,2}[a-zA-Z0-9][a-zA-Z0-9-]*,?)+)");
+  const std::regex flag("--[a-z][a-z0-9-]*");
+  for (std::sregex_iterator it(help.out.begin(), help.out.end(), option_line), end; it != end; ++it) {
+    const std::string names_of_line = (*it)[1].str();
+    for (std::sregex_iterator f(names_of_line.begin(), names_of_line.end(), flag); f != end; ++f)
+      names.insert(f->str());
+  }
   names.erase("--help");
   return names;
 }
@@ -102,7 +107,7 @@ std::map<std::string, Case> Cases(const Inputs& in) {
                      {{"--levels", "2"}, {"--limit", ""}, {"--overwrite", ""}}}},
       {"eval", {"eval " + dataset + " " + result + " --json " + Out("o_eval.json"), "o_eval.json",
                 {{"--overwrite", ""}, {"--threshold", "0.0031"}, {"--samples", "1234"}, {"--min-views", "3"},
-                 {"--visibility-tolerance", "0.0017"}, {"--hull", ""}}}},
+                 {"--visibility-tolerance", "0.0017"}, {"--hull", ""}, {"--error-maps", Out("o_eval_maps")}}}},
       {"export", {"export " + result + " --format glb --out " + Out("o_export.glb"), "o_export.glb.report.json",
                   {{"--overwrite", ""}, {"--dataset", dataset}, {"--fps", "17"}, {"--color", "flow"}, {"--up", "-y"},
                    {"--no-normals", ""}, {"--no-sparse", ""}}}},
@@ -151,7 +156,8 @@ const std::map<std::string, std::set<std::string>> kNotSet = {
     {"synth", {"--gray"}},               // excludes --color-cameras
     {"shape", {"--options"}},            // every option from a file instead of the flags
     {"motion", {"--seed", "--options"}},  // an earlier range's folder; a file of options
-    {"render", {"--no-dataset"}},       // excludes --dataset
+    {"render", {"--no-dataset",        // excludes --dataset
+                "--colour-by", "--colour-range"}},  // need an eval --error-maps folder (render_command_test)
     {"import", {"--videos", "--images", "--bounds", "--binning", "--colmap-names", "--min-camera-fraction",
                 "--name-pattern", "--preview", "--qualisys-raw-distortion", "--skip-unmatched"}},
     {"plan", {}},
