@@ -33,13 +33,14 @@ float MapAt(const cv::Mat& inverse_depth, const Eigen::Vector2d& pixel) {
 
 void DepthFusionOptions::Check() const {
   const std::string source = "depth fusion options";
-  support_plane.Check();
-  if (consistent_cameras < 0) ThrowError(source, "consistent_cameras", "expected ≥ 0");
+  if (consistent_cameras < 1) ThrowError(source, "consistent_cameras", "expected ≥ 1");
+  if (!(unconfirmed_min_score > -1 && unconfirmed_min_score <= 1.5))
+    ThrowError(source, "unconfirmed_min_score", "expected a value in (−1, 1.5] (above 1: never)");
   if (!(consistency_planes > 0)) ThrowError(source, "consistency_planes", "expected > 0");
   if (!(free_space_planes >= 0)) ThrowError(source, "free_space_planes", "expected ≥ 0");
   if (free_votes < 1) ThrowError(source, "free_votes", "expected ≥ 1");
   if (min_cameras < 1) ThrowError(source, "min_cameras", "expected ≥ 1");
-  if (!(support_tolerance_planes > 0)) ThrowError(source, "support_tolerance_planes", "expected > 0");
+  if (min_hits < 0) ThrowError(source, "min_hits", "expected ≥ 0");
   if (!(min_component_fraction >= 0 && min_component_fraction <= 1))
     ThrowError(source, "min_component_fraction", "expected a value in [0, 1]");
 }
@@ -51,7 +52,7 @@ std::vector<cv::Mat> TrustedDepths(const std::vector<Camera>& cameras, const std
   tbb::parallel_for(0, count, [&](int r) {
     const Camera& camera = cameras[r];
     const cv::Mat& map = maps[r].inverse_depth;
-    trusted[r] = cv::Mat::zeros(map.size(), CV_8U);
+    trusted[r] = cv::Mat(map.size(), CV_32F, cv::Scalar(kNoDepth));
     std::vector<Eigen::Matrix3d> rotation(count);
     std::vector<Eigen::Vector3d> offset(count);
     for (int j = 0; j < count; ++j) {
@@ -77,58 +78,28 @@ std::vector<cv::Mat> TrustedDepths(const std::vector<Camera>& cameras, const std
           if (std::abs(difference) <= tolerance) ++agree;
           else if (difference < 0) ++against;  // j sees through X (a surface in front of X only occludes it)
         }
-        if (agree >= 1 && agree >= std::min(options.consistent_cameras, agree + against)) trusted[r].at<uchar>(v, u) = 255;
+        const bool confirmed = agree >= 1 && agree >= std::min(options.consistent_cameras, agree + against);
+        const bool alone = agree + against == 0 && maps[r].score.at<float>(v, u) >= options.unconfirmed_min_score;
+        if (confirmed || alone) trusted[r].at<float>(v, u) = q;
       }
   });
   return trusted;
 }
 
-FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vector<DepthMap>& maps,
-                             const Bounds& bounds, int resolution, const DepthFusionOptions& options) {
+FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& trusted,
+                             const std::vector<double>& steps, const Bounds& bounds, int resolution,
+                             const SupportPlane* support, const DepthFusionOptions& options) {
   options.Check();
   Stopwatch start;
-  if (maps.size() != cameras.size()) ThrowError("depth fusion", "depth maps", "expected one per camera");
+  if (trusted.size() != cameras.size() || steps.size() != cameras.size())
+    ThrowError("depth fusion", "depth maps", "expected one map and one plane step per camera");
   for (std::size_t k = 0; k < cameras.size(); ++k)
-    if (!maps[k].inverse_depth.empty() &&
-        (maps[k].inverse_depth.cols != cameras[k].width() || maps[k].inverse_depth.rows != cameras[k].height()))
-      ThrowError("depth fusion", "depth map of camera " + cameras[k].name(), "expected the camera's size");
+    if (trusted[k].type() != CV_32FC1 || trusted[k].cols != cameras[k].width() ||
+        trusted[k].rows != cameras[k].height())
+      ThrowError("depth fusion", "depth map of camera " + cameras[k].name(), "expected CV_32FC1 of the camera's size");
   const int count = static_cast<int>(cameras.size());
   FusedOccupancy result;
-  std::vector<cv::Mat> trusted_masks = TrustedDepths(cameras, maps, options);
-  std::vector<cv::Mat> trusted(count);
-  result.trusted_pixels.resize(count);
-  result.depth_pixels.resize(count);
-  for (int k = 0; k < count; ++k) {
-    trusted[k] = cv::Mat(maps[k].inverse_depth.size(), CV_32F, cv::Scalar(-1.0f));
-    if (maps[k].inverse_depth.empty()) continue;
-    maps[k].inverse_depth.copyTo(trusted[k], trusted_masks[k]);
-    result.trusted_pixels[k] = cv::countNonZero(trusted_masks[k]);
-    result.depth_pixels[k] = maps[k].pixels_with_depth;
-  }
-
-  // Support plane from the trusted points inside the volume.
-  if (options.remove_support_plane) {
-    std::vector<Eigen::Vector3d> points;
-    std::vector<double> steps;
-    Eigen::Vector3d viewpoint = Eigen::Vector3d::Zero();
-    for (int k = 0; k < count; ++k) {
-      viewpoint += cameras[k].Center() / count;
-      for (int v = 0; v < trusted[k].rows; ++v)
-        for (int u = 0; u < trusted[k].cols; ++u) {
-          const float q = trusted[k].at<float>(v, u);
-          if (q <= 0) continue;
-          const Eigen::Vector3d X = PointAtDepth(cameras[k], Eigen::Vector2d(u, v), 1.0 / q);
-          if (!bounds.Contains(X)) continue;
-          points.push_back(X);
-          steps.push_back(maps[k].inverse_depth_step / (q * q));
-        }
-    }
-    if (points.size() >= 3) {
-      std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-      const double tolerance = options.support_tolerance_planes * steps[steps.size() / 2];
-      result.support = FindSupportPlane(points, viewpoint, tolerance, options.support_plane);
-    }
-  }
+  const bool remove_plane = support != nullptr && support->found;
 
   // Free space, per voxel.
   result.occupancy = MakeVoxelGrid(bounds, resolution);
@@ -138,7 +109,7 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
     for (int j = 0; j < grid.ny; ++j)
       for (int i = 0; i < grid.nx; ++i) {
         const Eigen::Vector3d X = grid.VoxelCenter(i, j, k);
-        if (result.support.found && result.support.SignedDistance(X) <= result.support.tolerance) continue;
+        if (remove_plane && support->SignedDistance(X) <= support->tolerance) continue;
         int seen = 0, freed = 0, hits = 0;
         for (int c = 0; c < count && freed < options.free_votes; ++c) {
           double depth = 0;
@@ -147,7 +118,7 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
           ++seen;
           // The trusted pixels of the voxel's footprint (a box of its half diagonal's size).
           const double q = 1.0 / depth;
-          const double tolerance = options.free_space_planes * maps[c].inverse_depth_step + half_diagonal * q * q;
+          const double tolerance = options.free_space_planes * steps[c] + half_diagonal * q * q;
           const double radius = half_diagonal * q * 0.5 * (cameras[c].K()(0, 0) + cameras[c].K()(1, 1));
           const cv::Mat& map = trusted[c];
           const int u0 = std::max(0, static_cast<int>(std::ceil(pixel.x() - radius))),

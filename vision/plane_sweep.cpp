@@ -54,16 +54,30 @@ struct ReferenceRays {
   double q_max = 0, q_min = std::numeric_limits<double>::infinity();  // over all pixels
 };
 
-ReferenceRays TraceRays(const Camera& camera, const Bounds& bounds) {
+// The normalized rays of every pixel (q_near, q_far left empty).
+ReferenceRays PixelRays(const Camera& camera) {
   ReferenceRays rays;
   const int w = camera.width(), h = camera.height();
-  for (cv::Mat* m : {&rays.x, &rays.y, &rays.q_near, &rays.q_far}) m->create(h, w, CV_32F);
+  rays.x.create(h, w, CV_32F);
+  rays.y.create(h, w, CV_32F);
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) {
       const Eigen::Vector2d xy = NormalizedPoint(camera, Eigen::Vector2d(u, v));
       rays.x.at<float>(v, u) = static_cast<float>(xy.x());
       rays.y.at<float>(v, u) = static_cast<float>(xy.y());
+    }
+  return rays;
+}
+
+ReferenceRays TraceRays(const Camera& camera, const Bounds& bounds) {
+  ReferenceRays rays = PixelRays(camera);
+  const int w = camera.width(), h = camera.height();
+  rays.q_near.create(h, w, CV_32F);
+  rays.q_far.create(h, w, CV_32F);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
       double z0 = 0, z1 = 0;
+      const Eigen::Vector2d xy(rays.x.at<float>(v, u), rays.y.at<float>(v, u));
       const bool hits = SlabDepths(camera, xy, bounds, &z0, &z1);
       rays.q_near.at<float>(v, u) = hits ? static_cast<float>(1.0 / z0) : kNone;
       rays.q_far.at<float>(v, u) = hits ? static_cast<float>(1.0 / z1) : kNone;
@@ -146,31 +160,37 @@ constexpr int kGridStep = 4;
 
 struct NeighbourGrid {
   RayTransfer transfer;
-  std::vector<int> us, vs;             // grid node coordinates
-  std::vector<Eigen::Vector3d> rays;   // R (x, y, 1) at the nodes, row-major
+  std::vector<int> us, vs;                       // grid node coordinates
+  std::vector<Eigen::Vector3d> rays, rotated;    // (x, y, 1) and R (x, y, 1) at the nodes, row-major
 };
 
 NeighbourGrid MakeGrid(const ReferenceRays& rays, const RayTransfer& transfer) {
-  NeighbourGrid grid{transfer, {}, {}, {}};
+  NeighbourGrid grid{transfer, {}, {}, {}, {}};
   const int h = rays.x.rows, w = rays.x.cols;
   for (int u = 0; u < w; u += kGridStep) grid.us.push_back(u);
   if (grid.us.back() != w - 1) grid.us.push_back(w - 1);
   for (int v = 0; v < h; v += kGridStep) grid.vs.push_back(v);
   if (grid.vs.back() != h - 1) grid.vs.push_back(h - 1);
   for (int v : grid.vs)
-    for (int u : grid.us)
-      grid.rays.push_back(transfer.R * Eigen::Vector3d(rays.x.at<float>(v, u), rays.y.at<float>(v, u), 1));
+    for (int u : grid.us) {
+      grid.rays.emplace_back(rays.x.at<float>(v, u), rays.y.at<float>(v, u), 1);
+      grid.rotated.push_back(transfer.R * grid.rays.back());
+    }
   return grid;
 }
 
-// map_x, map_y of plane q (−10 where the point is behind the target camera).
-void PlaneMap(const NeighbourGrid& grid, double q, cv::Mat* map_x, cv::Mat* map_y) {
+// map_x, map_y where each reference pixel's ray meets the surface of inverse depth
+// q(ray) (a plane of the reference camera: constant; a world plane: linear in the ray),
+// −10 where that point is behind the target camera or q < 0.
+template <typename InverseDepth>
+void SurfaceMap(const NeighbourGrid& grid, const InverseDepth& q_of_ray, cv::Mat* map_x, cv::Mat* map_y) {
   const int nu = static_cast<int>(grid.us.size()), nv = static_cast<int>(grid.vs.size());
   std::vector<Eigen::Vector2f> nodes(grid.rays.size());
   const Camera& target = *grid.transfer.target;
   for (std::size_t n = 0; n < grid.rays.size(); ++n) {
-    const Eigen::Vector3d X = grid.rays[n] + q * grid.transfer.b;
-    if (X.z() <= 1e-12) {
+    const double q = q_of_ray(grid.rays[n]);
+    const Eigen::Vector3d X = grid.rotated[n] + q * grid.transfer.b;
+    if (q < 0 || X.z() <= 1e-12) {
       nodes[n] = Eigen::Vector2f(-1e6f, -1e6f);
       continue;
     }
@@ -198,35 +218,33 @@ void PlaneMap(const NeighbourGrid& grid, double q, cv::Mat* map_x, cv::Mat* map_
     }
 }
 
-// NCC of the reference window with the neighbour image sampled on plane q.
-// reference_mean / reference_variance: box-filtered statistics of the reference image.
-cv::Mat PlaneNcc(const cv::Mat& reference, const cv::Mat& reference_mean, const cv::Mat& reference_variance,
-                 const ReferenceRays& rays, const NeighbourGrid& grid, const cv::Mat& neighbour_image,
-                 double q, const PlaneSweepOptions& options) {
-  const int h = reference.rows, w = reference.cols;
-  cv::Mat map_x(h, w, CV_32F), map_y(h, w, CV_32F), valid(h, w, CV_32F);
-  PlaneMap(grid, q, &map_x, &map_y);
-  const float low_x = -0.5f, high_x = neighbour_image.cols - 0.5f, low_y = -0.5f, high_y = neighbour_image.rows - 0.5f;
-  const float plane = static_cast<float>(q);
-  for (int v = 0; v < h; ++v) {
-    const float* q_near = rays.q_near.ptr<float>(v);
-    const float* q_far = rays.q_far.ptr<float>(v);
-    float* mx = map_x.ptr<float>(v);
-    float* my = map_y.ptr<float>(v);
-    float* ok = valid.ptr<float>(v);
-    for (int u = 0; u < w; ++u) {
-      const bool takes_part = q_near[u] >= 0 && plane <= q_near[u] && (options.sweep_beyond_volume || plane >= q_far[u]);
-      const bool inside = takes_part && mx[u] >= low_x && mx[u] < high_x && my[u] >= low_y && my[u] < high_y;
-      ok[u] = inside ? 1.0f : 0.0f;
-    }
-  }
+// Box-filtered statistics of the reference image for the NCC window.
+struct ReferenceStatistics {
+  cv::Mat image, mean, variance;
+};
+
+ReferenceStatistics MakeStatistics(const cv::Mat& image, const PlaneSweepOptions& options) {
+  ReferenceStatistics statistics{image, {}, {}};
+  const cv::Size window(2 * options.window_radius + 1, 2 * options.window_radius + 1);
+  cv::Mat square;
+  cv::boxFilter(image, statistics.mean, CV_32F, window);
+  cv::boxFilter(image.mul(image), square, CV_32F, window);
+  statistics.variance = cv::max(square - statistics.mean.mul(statistics.mean), 0.0);
+  return statistics;
+}
+
+// NCC of the reference windows with the neighbour image sampled at (map_x, map_y); −1
+// where a window has a pixel that is not `valid` (1 / 0) or texture-less.
+cv::Mat WarpNcc(const ReferenceStatistics& reference, const cv::Mat& neighbour_image, const cv::Mat& map_x,
+                const cv::Mat& map_y, const cv::Mat& valid, const PlaneSweepOptions& options) {
+  const int h = reference.image.rows, w = reference.image.cols;
   cv::Mat warped;
   cv::remap(neighbour_image, warped, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   const cv::Size window(2 * options.window_radius + 1, 2 * options.window_radius + 1);
   cv::Mat mean, mean_square, mean_product, valid_fraction;
   cv::boxFilter(warped, mean, CV_32F, window);
   cv::boxFilter(warped.mul(warped), mean_square, CV_32F, window);
-  cv::boxFilter(warped.mul(reference), mean_product, CV_32F, window);
+  cv::boxFilter(warped.mul(reference.image), mean_product, CV_32F, window);
   cv::boxFilter(valid, valid_fraction, CV_32F, window);
   cv::Mat ncc(h, w, CV_32F);
   for (int v = 0; v < h; ++v) {
@@ -234,8 +252,8 @@ cv::Mat PlaneNcc(const cv::Mat& reference, const cv::Mat& reference_mean, const 
     const float* m2 = mean_square.ptr<float>(v);
     const float* mp = mean_product.ptr<float>(v);
     const float* vf = valid_fraction.ptr<float>(v);
-    const float* rm = reference_mean.ptr<float>(v);
-    const float* rv = reference_variance.ptr<float>(v);
+    const float* rm = reference.mean.ptr<float>(v);
+    const float* rv = reference.variance.ptr<float>(v);
     float* out = ncc.ptr<float>(v);
     for (int u = 0; u < w; ++u) {
       const float variance = std::max(0.0f, m2[u] - m[u] * m[u]);
@@ -244,6 +262,34 @@ cv::Mat PlaneNcc(const cv::Mat& reference, const cv::Mat& reference_mean, const 
     }
   }
   return ncc;
+}
+
+// 1 where the map lands inside the target image and `takes_part(u, v)`, else 0.
+template <typename TakesPart>
+cv::Mat ValidSamples(const cv::Mat& map_x, const cv::Mat& map_y, const Camera& target, const TakesPart& takes_part) {
+  cv::Mat valid(map_x.size(), CV_32F);
+  const float low = -0.5f, high_x = target.width() - 0.5f, high_y = target.height() - 0.5f;
+  for (int v = 0; v < map_x.rows; ++v) {
+    const float* mx = map_x.ptr<float>(v);
+    const float* my = map_y.ptr<float>(v);
+    float* ok = valid.ptr<float>(v);
+    for (int u = 0; u < map_x.cols; ++u)
+      ok[u] = takes_part(u, v) && mx[u] >= low && mx[u] < high_x && my[u] >= low && my[u] < high_y ? 1.0f : 0.0f;
+  }
+  return valid;
+}
+
+// NCC of the reference window with the neighbour image sampled on plane q of the sweep.
+cv::Mat PlaneNcc(const ReferenceStatistics& reference, const ReferenceRays& rays, const NeighbourGrid& grid,
+                 const cv::Mat& neighbour_image, double q, const PlaneSweepOptions& options) {
+  cv::Mat map_x(reference.image.size(), CV_32F), map_y(reference.image.size(), CV_32F);
+  SurfaceMap(grid, [q](const Eigen::Vector3d&) { return q; }, &map_x, &map_y);
+  const float plane = static_cast<float>(q);
+  const cv::Mat valid = ValidSamples(map_x, map_y, *grid.transfer.target, [&](int u, int v) {
+    const float q_near = rays.q_near.at<float>(v, u);
+    return q_near >= 0 && plane <= q_near && (options.sweep_beyond_volume || plane >= rays.q_far.at<float>(v, u));
+  });
+  return WarpNcc(reference, neighbour_image, map_x, map_y, valid, options);
 }
 
 // The best-views mean of the neighbours' NCC per pixel, quantized to 8 bits (q / 127.5 − 1).
@@ -291,12 +337,7 @@ DepthMap SweepOne(const std::vector<Camera>& cameras, const std::vector<cv::Mat>
   result.inverse_depth_step = (q_high - q_low) / (planes - 1);
   const int views = std::min<int>(options.consistent_views, transfers.size());
 
-  const cv::Mat& reference = gray[r];
-  const cv::Size window(2 * options.window_radius + 1, 2 * options.window_radius + 1);
-  cv::Mat reference_mean, reference_square, reference_variance;
-  cv::boxFilter(reference, reference_mean, CV_32F, window);
-  cv::boxFilter(reference.mul(reference), reference_square, CV_32F, window);
-  reference_variance = cv::max(reference_square - reference_mean.mul(reference_mean), 0.0);
+  const ReferenceStatistics reference = MakeStatistics(gray[r], options);
 
   // Scores of every plane (8 bits), kept for the uniqueness test.
   std::vector<cv::Mat> volume(planes);
@@ -304,8 +345,7 @@ DepthMap SweepOne(const std::vector<Camera>& cameras, const std::vector<cv::Mat>
   const auto plane_q = [&](int i) { return q_low + result.inverse_depth_step * i; };
   for (int i = 0; i < planes; ++i) {
     for (std::size_t j = 0; j < transfers.size(); ++j)
-      ncc[j] = PlaneNcc(reference, reference_mean, reference_variance, rays, grids[j],
-                        gray[result.neighbours[j]], plane_q(i), options);
+      ncc[j] = PlaneNcc(reference, rays, grids[j], gray[result.neighbours[j]], plane_q(i), options);
     volume[i] = BestViewsScore(ncc, views);
   }
 
@@ -315,7 +355,7 @@ DepthMap SweepOne(const std::vector<Camera>& cameras, const std::vector<cv::Mat>
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) {
       if (!known.empty() && !known.at<uchar>(v, u)) continue;
-      if (std::sqrt(reference_variance.at<float>(v, u)) < options.min_texture) continue;
+      if (std::sqrt(reference.variance.at<float>(v, u)) < options.min_texture) continue;
       int best = -1;
       uchar best_q = 0;
       for (int i = 0; i < planes; ++i)
@@ -336,6 +376,44 @@ DepthMap SweepOne(const std::vector<Camera>& cameras, const std::vector<cv::Mat>
 }
 
 }  // namespace
+
+PlaneHypothesis ScorePlane(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& gray, int r,
+                           const std::vector<int>& neighbours, const Eigen::Vector3d& normal, double offset,
+                           const PlaneSweepOptions& options) {
+  const Camera& camera = cameras[r];
+  PlaneHypothesis result;
+  const int h = camera.height(), w = camera.width();
+  result.inverse_depth = cv::Mat(h, w, CV_32F, cv::Scalar(kNone));
+  result.score = cv::Mat(h, w, CV_32F, cv::Scalar(kNone));
+  if (neighbours.empty()) return result;
+  // n·(C + z Rᵀ ray) + d = 0  ⇒  q = 1/z = −(n·Rᵀ ray) / (n·C + d).
+  const Eigen::Vector3d n_camera = camera.R() * normal;
+  const double height = normal.dot(camera.Center()) + offset;
+  if (std::abs(height) < 1e-12) return result;  // the camera lies on the plane
+  const auto q_of_ray = [&](const Eigen::Vector3d& ray) { return -n_camera.dot(ray) / height; };
+  const ReferenceRays rays = PixelRays(camera);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const double q = q_of_ray(Eigen::Vector3d(rays.x.at<float>(v, u), rays.y.at<float>(v, u), 1));
+      if (q > 0) result.inverse_depth.at<float>(v, u) = static_cast<float>(q);
+    }
+  const ReferenceStatistics reference = MakeStatistics(gray[r], options);
+  std::vector<cv::Mat> ncc;
+  for (int j : neighbours) {
+    const NeighbourGrid grid = MakeGrid(rays, RayTransfer(camera, cameras[j]));
+    cv::Mat map_x(h, w, CV_32F), map_y(h, w, CV_32F);
+    SurfaceMap(grid, q_of_ray, &map_x, &map_y);
+    const cv::Mat valid = ValidSamples(map_x, map_y, cameras[j],
+                                       [&](int u, int v) { return result.inverse_depth.at<float>(v, u) > 0; });
+    ncc.push_back(WarpNcc(reference, gray[j], map_x, map_y, valid, options));
+  }
+  const cv::Mat quantized = BestViewsScore(ncc, std::min<int>(options.consistent_views, ncc.size()));
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u)
+      if (result.inverse_depth.at<float>(v, u) > 0 && std::sqrt(reference.variance.at<float>(v, u)) >= options.min_texture)
+        result.score.at<float>(v, u) = quantized.at<uchar>(v, u) / 127.5f - 1.0f;
+  return result;
+}
 
 void PlaneSweepOptions::Check() const {
   const std::string source = "plane sweep options";

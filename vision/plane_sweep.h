@@ -97,6 +97,20 @@ std::vector<DepthMap> SweepDepthMaps(const std::vector<Camera>& cameras, const s
                                      const Bounds& bounds, const PlaneSweepOptions& options = {},
                                      const std::vector<cv::Mat>& known = {});
 
+// The hypothesis that every pixel of camera r sees the world plane normal·X + offset = 0
+// (e.g. a support plane, which continues beyond the working volume): per pixel the plane's
+// inverse depth (−1 where it is behind the camera) and the score of the sweep (mean NCC of
+// the best consistent_views of `neighbours`), with the neighbours' windows warped by the
+// plane's homography, so that a floor seen at a grazing angle correlates as well as a
+// fronto-parallel surface; −1 where undefined or texture-less (min_texture).
+struct PlaneHypothesis {
+  cv::Mat inverse_depth;  // CV_32FC1
+  cv::Mat score;          // CV_32FC1
+};
+PlaneHypothesis ScorePlane(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& gray, int r,
+                           const std::vector<int>& neighbours, const Eigen::Vector3d& normal, double offset,
+                           const PlaneSweepOptions& options = {});
+
 // The world point of pixel (u, v) of `camera` at depth z (z along the optical axis).
 Eigen::Vector3d PointAtDepth(const Camera& camera, const Eigen::Vector2d& pixel, double z);
 
