@@ -40,6 +40,9 @@
 namespace subflow::vision {
 
 struct StillEvidenceOptions {
+  // Shape initialization uses the still evidence when nothing else finds the object
+  // (solver/shape/shape_init.h); false = never (such datasets are then an error).
+  bool enabled = true;
   PlaneSweepOptions sweep;
   DepthFusionOptions fusion;
   // Find and remove a support plane (step 3).
