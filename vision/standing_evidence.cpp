@@ -31,7 +31,8 @@ Silhouette StandingSilhouette(const EstimatedBackground& background, const Silho
   const double threshold = std::max(options.min_threshold, options.noise_factor * values[values.size() / 2]);
   cv::Mat measure = instability.clone();
   measure.setTo(0.0f, background.known == 0);  // unknown pixels are the difference silhouette's affair
-  result = ThresholdAndClean(measure, threshold, silhouettes, silhouettes.background_open_radius);
+  // No opening: like motion evidence, the sway shows as thin bands along outlines and edges.
+  result = ThresholdAndClean(measure, threshold, silhouettes, 0);
   result.source = EvidenceSource::kBackground;
   return result;
 }

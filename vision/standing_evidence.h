@@ -12,10 +12,10 @@
 // something sways. The standing silhouette of a camera is
 //     s(p) > noise_factor · median_p s(p)       (the median over the known pixels: the
 //                                                 noise, most of an image being static),
-// never below min_threshold, cleaned as any thresholded measure (opening, closing, small
-// regions removed, holes filled: vision/silhouettes.h ThresholdAndClean). A sway shows
-// mostly along the person's outline and texture; the closing and the hole filling make
-// it a region. Shape initialization adds it to each frame's silhouette of that camera
+// never below min_threshold, cleaned as motion evidence is (closing, small regions
+// removed, holes filled, no opening: vision/silhouettes.h ThresholdAndClean). A sway shows
+// as thin bands along the person's outline and texture; the closing and the hole filling
+// make them a region. Shape initialization adds it to each frame's silhouette of that camera
 // (the union: moving parts by the difference to the estimated background, standing parts
 // by their sway); voxel carving then keeps only what the cameras agree on, so the sway
 // of things outside the working volume (people in the back of the room) or the flicker
@@ -50,8 +50,7 @@ struct StandingEvidenceOptions {
 
 // The standing silhouette of one camera from its estimated background (valid(), with
 // `instability`); an empty silhouette (source kBackground) when the estimate is invalid.
-// Cleaning as `silhouettes` says (close_radius, fill_holes, min_region_pixels,
-// background_open_radius).
+// Cleaning as `silhouettes` says (close_radius, fill_holes, min_region_pixels; no opening).
 Silhouette StandingSilhouette(const EstimatedBackground& background, const SilhouetteOptions& silhouettes,
                               const StandingEvidenceOptions& options = {});
 
