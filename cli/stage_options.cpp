@@ -43,7 +43,8 @@ void AddFramesOption(CLI::App* sub, int* first, int* count, bool allow_count) {
 
 void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string* evidence) {
   sub->add_option("--evidence", *evidence,
-                  "Object evidence: auto (masks, else background, else motion), mask, background, motion")
+                  "Object evidence: auto (masks, else background, else motion (with what stands still), else "
+                  "still: photo-consistency of the reference frame), mask, background, motion, still")
       ->capture_default_str();
   sub->add_option("--levels", o->levels, "Subdivision levels above the base mesh")->capture_default_str();
   sub->add_option("--base-faces", o->simplify.target_face_count, "Faces of the base mesh T0")

@@ -23,6 +23,8 @@
 #include "solver/shape/shape_init.h"
 #include "solver/stereo/stereo_refinement.h"
 #include "vision/silhouettes.h"
+#include "vision/standing_evidence.h"
+#include "vision/still_evidence.h"
 #include "vision/voxel_carving.h"
 
 namespace subflow::output {
@@ -74,6 +76,17 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SilhouetteOptions, source, background_blur_si
                                    motion_threshold, motion_method, motion_min_threshold, estimate_background,
                                    background_estimate_min_frames, background_estimate_margin, close_radius,
                                    fill_holes, min_region_pixels, min_object_pixels)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StandingEvidenceOptions, enabled, noise_factor, min_threshold)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(PlaneSweepOptions, neighbours, max_neighbour_degrees, consistent_views,
+                                   window_radius, max_step_pixels, max_planes, sweep_beyond_volume, min_score,
+                                   min_texture, uniqueness_margin, uniqueness_planes, threads)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DepthFusionOptions, consistent_cameras, consistency_planes,
+                                   unconfirmed_min_score, free_space_planes, free_votes, min_hits, min_cameras,
+                                   min_component_fraction)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SupportPlaneOptions, tolerance, iterations, sample_points, min_inlier_fraction,
+                                   min_above_fraction, seed)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StillEvidenceOptions, enabled, sweep, fusion, remove_support_plane,
+                                   support_plane, support_tolerance_planes)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VoxelCarvingOptions, resolution, pixels_per_voxel, max_auto_resolution,
                                    max_pixels_per_voxel,
                                    min_cameras, max_misses, evidence_threshold, footprint_margin, closing_radius,
@@ -96,7 +109,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_norma
 namespace subflow::solver {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, carving, isosurface, simplify, fit, levels,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, standing, still, carving, isosurface, simplify, fit, levels,
                                    reference_frame, first_frame, frame_count, image_edge_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,

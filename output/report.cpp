@@ -85,6 +85,31 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
                                     {"mean_free_frames", background.mean_free_frames}});
   }
 
+  // What stands still, added to the silhouettes from estimated backgrounds (null: none).
+  nlohmann::json standing = nullptr;
+  for (size_t c = 0; c < result.standing.size(); ++c) {
+    if (standing.is_null()) standing = nlohmann::json::array();
+    standing.push_back({{"name", dataset.camera(static_cast<int>(c)).name()},
+                        {"threshold", result.standing[c].threshold},
+                        {"object_pixels", result.standing[c].object_pixels}});
+  }
+  // The still set's photo-consistency, when it was the evidence (null: not used).
+  nlohmann::json still = nullptr;
+  if (result.used_still) {
+    nlohmann::json cameras = nlohmann::json::array();
+    for (const vision::StillCameraReport& camera : result.still.cameras)
+      cameras.push_back({{"name", camera.name}, {"planes", camera.planes}, {"depth_pixels", camera.depth_pixels},
+                         {"trusted_pixels", camera.trusted_pixels}, {"support_pixels", camera.support_pixels},
+                         {"silhouette_pixels", camera.silhouette_pixels}, {"sweep_seconds", camera.sweep_seconds}});
+    const vision::SupportPlane& plane = result.still.support;
+    still = {{"support_plane", {{"found", plane.found}, {"normal", Vector3(plane.normal)}, {"offset", plane.offset},
+                                {"tolerance", plane.tolerance}, {"inliers", plane.inliers}, {"points", plane.points},
+                                {"above_fraction", plane.above_fraction}}},
+             {"occupied_voxels", result.still.fused.occupied_voxels},
+             {"cameras", cameras},
+             {"seconds", result.still.seconds}};
+  }
+
   nlohmann::json frames = nlohmann::json::array();
   double carve = 0, isosurface = 0, fit = 0;
   for (const auto& frame : result.frames) {
@@ -132,6 +157,8 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
                          {"simplify_attempts", result.simplify.attempts}}},
           {"levels", levels},
           {"estimated_background", estimated},
+          {"standing", standing},
+          {"still", still},
           {"frames", frames},
           {"seconds", {{"carve", carve}, {"isosurface", isosurface}, {"simplify", result.simplify_seconds},
                        {"fit", fit}}}};

@@ -27,12 +27,22 @@
 #include "solver/shape/hierarchy_fit.h"
 #include "vision/dataset.h"
 #include "vision/silhouettes.h"
+#include "vision/standing_evidence.h"
+#include "vision/still_evidence.h"
 #include "vision/voxel_carving.h"
 
 namespace subflow::solver {
 
 struct ShapeInitOptions {
   vision::SilhouetteOptions silhouettes;
+  // Cameras whose silhouettes come from a background estimated from the video: what
+  // stands (almost) still in the take is added to them (vision/standing_evidence.h).
+  vision::StandingEvidenceOptions standing;
+  // When no frame has any evidence (no masks, no background images, nothing moves: a
+  // still set of one frame, or a take in which nobody moves), or with silhouettes.source
+  // kStill: the photo-consistency of the still set formed by the reference frame of every
+  // camera (vision/still_evidence.h) is every frame's evidence.
+  vision::StillEvidenceOptions still;
   vision::VoxelCarvingOptions carving;
   geometry::IsosurfaceOptions isosurface;
   geometry::SimplifyOptions simplify;  // target_face_count = faces of the base mesh T0
@@ -85,6 +95,12 @@ struct ShapeInitResult {
   // empty when none was estimated.
   std::vector<vision::EstimatedBackground> estimated_backgrounds;
   double estimate_background_seconds = 0;
+  // Per camera, the standing silhouette added to every frame's (vision/standing_evidence.h;
+  // masks released, figures kept); empty when none was computed.
+  std::vector<vision::Silhouette> standing;
+  // The still set's evidence, when it was used (used_still; silhouettes released).
+  bool used_still = false;
+  vision::StillEvidence still;
   // Per camera, the scale of the images the evidence was computed on (1 = stored size;
   // VoxelCarvingOptions::max_pixels_per_voxel).
   std::vector<double> evidence_scales;
