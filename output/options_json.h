@@ -87,7 +87,8 @@ namespace subflow::geometry {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(IsosurfaceOptions, iso_value, smoothing_sigma_voxels, padding_voxels,
                                    facet_angle_degrees, facet_size_voxels, facet_distance_voxels,
                                    max_vertex_count, random_seed)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_normal_change_degrees,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_distance, min_face_count,
+                                   max_face_count, max_normal_change_degrees,
                                    min_triangle_angle_degrees, max_valence, min_valence, flip_rounds,
                                    max_flip_dihedral_degrees, check_self_intersections, max_attempts, retry_growth)
 
@@ -96,7 +97,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_norma
 namespace subflow::solver {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, carving, isosurface, simplify, fit, levels,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, carving, isosurface, simplify, fit,
+                                   base_distance_voxels, levels, finest_edge_pixels, max_finest_faces,
                                    reference_frame, first_frame, frame_count, image_edge_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,
