@@ -102,6 +102,8 @@ void RunEval(const EvalSettings& settings) {
   if (!settings.json_path.empty()) {
     nlohmann::json json = nlohmann::json::parse(report.Json());
     json["rigid_motion"] = rigid;
+    json["command"] = "eval";
+    json["arguments"] = InvocationArguments();
     output::WriteJsonFile(settings.json_path, json);
   }
 }

@@ -46,6 +46,7 @@ void RunRender(const RenderArguments& arguments) {
       output::RenderResultPictures(result, dataset.get(), metadata, arguments.out, options, &progress);
   nlohmann::json report = summary.Json();
   report["command"] = "render";
+  report["arguments"] = InvocationArguments();
   report["versions"] = output::VersionsJson();
   report["result"] = arguments.result;
   report["dataset"] = metadata.dataset_directory;

@@ -117,6 +117,9 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
   sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
   sub->add_option("--iterations", o->solver.max_iterations, "Ceres iterations per window and round")
       ->capture_default_str();
+  sub->add_option("--function-tolerance", o->solver.function_tolerance,
+                  "A window's solve ends when an iteration lowers the cost by less than this fraction")
+      ->capture_default_str();
   sub->add_option_function<std::string>(
          "--linear-solver",
          [o](const std::string& name) {

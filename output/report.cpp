@@ -49,6 +49,7 @@ nlohmann::json DatasetJson(const vision::Dataset& dataset) {
 
 nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset) {
   return {{"command", run.command},
+          {"arguments", run.arguments},
           {"output", run.out},
           {"overwrite", run.overwrite},
           {"resume", run.resume},
