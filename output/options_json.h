@@ -100,7 +100,8 @@ namespace subflow::geometry {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(IsosurfaceOptions, iso_value, smoothing_sigma_voxels, padding_voxels,
                                    facet_angle_degrees, facet_size_voxels, facet_distance_voxels,
                                    max_vertex_count, random_seed)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_normal_change_degrees,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_distance, min_face_count,
+                                   max_face_count, max_normal_change_degrees,
                                    min_triangle_angle_degrees, max_valence, min_valence, flip_rounds,
                                    max_flip_dihedral_degrees, check_self_intersections, max_attempts, retry_growth)
 
@@ -109,7 +110,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_norma
 namespace subflow::solver {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, standing, still, carving, isosurface, simplify, fit, levels,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, standing, still, carving, isosurface, simplify, fit,
+                                   base_distance_voxels, levels, finest_edge_pixels, max_finest_faces,
                                    reference_frame, first_frame, frame_count, image_edge_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,
@@ -122,6 +124,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solv
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(WindowSolverOptions, linear_solver, max_iterations, threads, function_tolerance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
+                                   per_patch_levels,
                                    normal_only_from_level, window, window_overlap, rounds, solver,
                                    samples_per_pixel, min_density, max_density, max_cameras, min_samples,
                                    image_sigma, ncc_epsilon, ncc_loss_scale, temporal_weight, silhouette_weight,

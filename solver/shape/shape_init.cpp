@@ -167,7 +167,12 @@ void ShapeInitOptions::Check() const {
   isosurface.Check();
   simplify.Check();
   fit.Check();
-  if (levels < 0 || levels > 6) ThrowError("shape init options", "levels", "expected 0..6");
+  if (levels < -1 || levels > 6) ThrowError("shape init options", "levels", "expected 0..6, or −1 for automatic");
+  if (!(base_distance_voxels >= 0 && base_distance_voxels <= 100))
+    ThrowError("shape init options", "base_distance_voxels", "expected 0 (by count) or a distance in (0, 100] voxels");
+  if (!(finest_edge_pixels >= 0.25 && finest_edge_pixels <= 1000))
+    ThrowError("shape init options", "finest_edge_pixels", "expected a length in [0.25, 1000] pixels");
+  if (max_finest_faces < 4) ThrowError("shape init options", "max_finest_faces", "expected at least 4");
   if (first_frame < 0) ThrowError("shape init options", "first_frame", "expected ≥ 0");
   if (frame_count == 0 || frame_count < -1)
     ThrowError("shape init options", "frame_count", "expected > 0, or −1 for all frames");
@@ -247,15 +252,17 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   // Base mesh and hierarchy from the reference frame.
   Stopwatch start;
   const FrameShapeInit& reference_frame = result.frames[reference - first];
-  result.base_mesh = geometry::SimplifyMesh(reference_frame.hull, options.simplify,
-                                            &result.simplify,
-                                            "visual hull of frame " + vision::FrameName(reference));
+  result.resolution = ChooseBaseResolution(reference_frame.hull, dataset.cameras(), voxel_size, options,
+                                           "visual hull of frame " + vision::FrameName(reference));
+  result.base_mesh = std::move(result.resolution.base);
+  result.simplify = result.resolution.simplify;
   result.simplify_seconds = start.Seconds();
+  const int levels = result.resolution.levels;
   result.hierarchy = std::make_shared<const geometry::LoopHierarchy>(
-      result.base_mesh.F, result.base_mesh.vertex_count(), options.levels, "base mesh");
+      result.base_mesh.F, result.base_mesh.vertex_count(), levels, "base mesh");
   spdlog::info("base mesh: {} vertices, {} faces; {} levels, finest {} faces",
-               result.base_mesh.vertex_count(), result.base_mesh.face_count(), options.levels,
-               result.hierarchy->FaceCount(options.levels));
+               result.base_mesh.vertex_count(), result.base_mesh.face_count(), levels,
+               result.hierarchy->FaceCount(levels));
 
   // Fit the hierarchy to every frame's hull, outwards from the reference frame.
   ProgressBegin(progress, "fit subdivision surface", count);

@@ -34,8 +34,9 @@
 //
 // Visibility and samples are recomputed `rounds` times per level as the shape changes.
 // Adaptivity: at level ℓ + 1 only the patches whose parent's corners moved by more than
-// adaptive_threshold · h_ℓ at level ℓ (in some frame) are refined; the rest keep their
-// details. The report says how much of the surface reached each level.
+// adaptive_threshold · h_ℓ at level ℓ (in some frame) are refined, and, below the median
+// resolved level, only those that still cover min_patch_area (patch_levels.h); the rest
+// keep their details. The report says how much of the surface reached each level.
 //
 // The code, in the order of a level's refinement (all in solver/stereo/):
 //   level_sampling.h           the samples of a level and their limit stencils
@@ -91,6 +92,11 @@ struct StereoRefinementOptions {
   // and end-point error.
   int finest_level = -1;
   double min_patch_area = 20.0;
+  // With the automatic finest level: below the median level above, patches are refined
+  // where their parent moved and they still cover min_patch_area themselves, down to the
+  // deepest level any patch reaches (solver/stereo/patch_levels.h); false = stop at the
+  // median level everywhere.
+  bool per_patch_levels = true;
   // Levels ≥ this refine the normal detail only (dof 1). Tangential increments are nearly
   // unconstrained by stereo (the correlation does not change when the surface slides along
   // itself), so by default every level keeps the tangential motion of motion
