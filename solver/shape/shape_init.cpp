@@ -247,6 +247,10 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     estimated.image.release(), estimated.known.release(), estimated.instability.release();
   for (vision::Silhouette& standing : result.standing)
     standing.evidence.release(), standing.mask.release(), standing.measure.release();
+  if (result.used_still && std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end())
+    ThrowError(dataset.directory(), "evidence",
+               "no masks, no background, nothing moves, and the photo-consistency of the still set (evidence "
+               "\"still\") found no surface either: cannot find the object (give masks or background images)");
   TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames);
 
   // Base mesh and hierarchy from the reference frame.

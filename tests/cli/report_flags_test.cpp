@@ -60,6 +60,9 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--evidence", {"background", "/options/shape_init/silhouettes/source", "background"}},
       {"--levels", {"1", "/options/shape_init/levels", 1}},
       {"--base-faces", {"60", "/options/shape_init/simplify/target_face_count", 60}},
+      // --base-faces selects the count mode: the distance bound given too is set to 0.
+      {"--base-distance", {"1.5", "/options/shape_init/base_distance_voxels", 0.0}},
+      {"--finest-edge-pixels", {"1.5", "/options/shape_init/finest_edge_pixels", 1.5}},
       {"--reference-frame", {"2", "/options/shape_init/reference_frame", 2}},
       {"--first-frame", {"1", "/options/shape_init/first_frame", 1}},
       {"--frames", {"2", "/options/shape_init/frame_count", 2}},
