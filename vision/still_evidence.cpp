@@ -111,18 +111,7 @@ SupportPlane FindPlane(const std::vector<Camera>& cameras, const std::vector<cv:
   plane.normal = normal;
   plane.offset = offset;
   plane.tolerance = tolerance;
-  plane.points = static_cast<int>(points.size());
-  int above = 0, rest = 0;
-  for (const Eigen::Vector3d& X : points) {
-    const double distance = plane.SignedDistance(X);
-    if (std::abs(distance) <= tolerance) {
-      ++plane.inliers;
-    } else {
-      ++rest;
-      above += distance > 0;
-    }
-  }
-  plane.above_fraction = rest ? static_cast<double>(above) / rest : 1.0;
+  plane.CountSides(points);
   plane.found = plane.above_fraction >= options.support_plane.min_above_fraction && best_pixels > 0;
   return plane;
 }

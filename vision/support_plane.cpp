@@ -29,6 +29,22 @@ std::string SupportPlane::Describe() const {
                      found ? "" : " (not a support plane)");
 }
 
+void SupportPlane::CountSides(const std::vector<Eigen::Vector3d>& all) {
+  points = static_cast<int>(all.size());
+  inliers = 0;
+  int above = 0, rest = 0;
+  for (const Eigen::Vector3d& X : all) {
+    const double distance = SignedDistance(X);
+    if (std::abs(distance) <= tolerance) {
+      ++inliers;
+    } else {
+      ++rest;
+      above += distance > 0;
+    }
+  }
+  above_fraction = rest ? static_cast<double>(above) / rest : 1.0;
+}
+
 SupportPlane FindSupportPlane(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& viewpoint,
                               double tolerance, const SupportPlaneOptions& options) {
   options.Check();
@@ -79,18 +95,7 @@ SupportPlane FindSupportPlane(const std::vector<Eigen::Vector3d>& points, const 
   plane.normal = best_normal;
   plane.offset = best_offset;
 
-  int above = 0, rest = 0;
-  plane.inliers = 0;
-  for (const Eigen::Vector3d& X : points) {
-    const double distance = plane.SignedDistance(X);
-    if (std::abs(distance) <= tolerance) {
-      ++plane.inliers;
-    } else {
-      ++rest;
-      above += distance > 0;
-    }
-  }
-  plane.above_fraction = rest ? static_cast<double>(above) / rest : 1.0;
+  plane.CountSides(points);
   plane.found = plane.inliers >= options.min_inlier_fraction * points.size() &&
                 plane.above_fraction >= options.min_above_fraction;
   return plane;

@@ -45,6 +45,8 @@ struct SupportPlane {
   bool found = false;         // passed both tests
 
   double SignedDistance(const Eigen::Vector3d& X) const { return normal.dot(X) + offset; }
+  // Sets points, inliers (|n·X + d| ≤ tolerance) and above_fraction from `points`.
+  void CountSides(const std::vector<Eigen::Vector3d>& points);
   std::string Describe() const;  // "n = (…), d = …, inliers …/…, above …"
 };
 
