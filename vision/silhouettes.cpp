@@ -235,14 +235,13 @@ void SetMask(const cv::Mat& mask, const SilhouetteOptions& options, Silhouette* 
 }  // namespace
 
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options, int open_radius, double contrast_fraction) {
+                             const SilhouetteOptions& options, int open_radius) {
   SUBFLOW_CHECK(measure.type() == CV_32FC1, "ThresholdAndClean expects CV_32FC1");
   Silhouette silhouette;
   silhouette.measure = measure;
   silhouette.threshold = threshold;
   cv::Mat mask = measure > threshold;  // CV_8U 0 / 255
   if (open_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_OPEN, Disk(open_radius));
-  if (contrast_fraction > 0) mask = HalfContrastContour(measure, mask, contrast_fraction);
   if (options.close_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, Disk(options.close_radius));
   if (options.min_region_pixels > 1) RemoveSmallRegions(&mask, options.min_region_pixels);
   if (options.fill_holes) FillHoles(&mask);
@@ -336,8 +335,7 @@ Silhouette SilhouetteFromDifference(const cv::Mat& image, const cv::Mat& backgro
                                                       : plain;
   if (!unknown.empty()) difference.setTo(1.0f, unknown);
   const cv::Mat measure = Smooth(difference, options.background_blur_sigma);
-  const double pre = std::getenv("PRE") ? std::atof(std::getenv("PRE")) : 0.0;
-  Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius, pre);
+  Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius);
   silhouette.source = EvidenceSource::kBackground;
   if (options.background_contour_fraction > 0)
     SetMask(HalfContrastContour(measure, silhouette.mask, options.background_contour_fraction), options,

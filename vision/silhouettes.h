@@ -283,8 +283,7 @@ Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const Estimat
 // options.min_region_pixels removed, holes filled (options.fill_holes); fills every
 // field of the returned Silhouette except `source`.
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options, int open_radius = 0,
-                             double contrast_fraction = 0);
+                             const SilhouetteOptions& options, int open_radius = 0);
 
 // The evidence camera `camera` of `dataset` takes for EvidenceSource::kAuto: masks if the
 // dataset has them, else the background image if background/<camera>.png exists, else

@@ -69,8 +69,6 @@ cv::Mat DecodeSrgb(const cv::Mat& encoded) {
 
 namespace {
 
-const double kInformative = std::getenv("INFORM") ? std::atof(std::getenv("INFORM")) : 2.0;
-
 // Σ over the window W(q) of image(p)·k(p − q), for every q: a correlation with kernel k.
 cv::Mat WindowSum(const cv::Mat& image, const cv::Mat& kernel) {
   cv::Mat sum;
@@ -87,10 +85,12 @@ struct WindowShape {
   std::vector<cv::Point> neighbours;   // offsets q − p of the windows that lend p their gain
 };
 
-WindowShape Square(int radius, int reach) {
-  WindowShape shape{radius, cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_32F), true, {}};
-  for (int dy = -reach; dy <= reach; ++dy)
-    for (int dx = -reach; dx <= reach; ++dx) shape.neighbours.emplace_back(dx, dy);
+// A pixel p takes gains from the windows that contain it: those centred at p − o for the
+// window's own offsets o (the windows are symmetric about their centre).
+WindowShape Square(int radius, bool ramp) {
+  WindowShape shape{radius, cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_32F), ramp, {}};
+  for (int dy = -radius; dy <= radius; ++dy)
+    for (int dx = -radius; dx <= radius; ++dx) shape.neighbours.emplace_back(dx, dy);
   return shape;
 }
 
@@ -109,10 +109,9 @@ WindowShape Line(int radius, cv::Point direction) {
 struct WindowGains {
   WindowShape shape;
   cv::Mat alpha, beta, gamma;  // CV_32FC1 each
-  cv::Mat informative;         // CV_8UC1: the background's texture in the window tells a flat object from a shadow
 };
 
-WindowGains FitWindowGains(const cv::Mat& b, const cv::Mat& bb, const cv::Mat& ab, const cv::Mat& aa, int channels,
+WindowGains FitWindowGains(const cv::Mat& bb, const cv::Mat& ab, const cv::Mat& aa, int channels,
                            double tolerance, const WindowShape& shape, const SilhouetteOptions& options) {
   const int w = shape.radius, side = 2 * w + 1;
   cv::Mat u(side, side, CV_32F), v(side, side, CV_32F);
@@ -126,14 +125,11 @@ WindowGains FitWindowGains(const cv::Mat& b, const cv::Mat& bb, const cv::Mat& a
     m01 = WindowSum(bb, u), m02 = WindowSum(bb, v), m11 = WindowSum(bb, u.mul(u)), m12 = WindowSum(bb, u.mul(v));
     m22 = WindowSum(bb, v.mul(v)), h1 = WindowSum(ab, u), h2 = WindowSum(ab, v);
   }
-  const double pixels = cv::sum(shape.kernel)[0], samples = channels * pixels;
-  // Σ_c (Σ_W b_c)²: with Σ_W Σ_c b² the spatial variance of the background in the window.
-  const cv::Mat b_sums = SumChannels([&] { cv::Mat sums = WindowSum(b, shape.kernel); return sums.mul(sums); }());
-  const double informative_squared = kInformative * kInformative * tolerance * tolerance;
+  const double samples = channels * cv::sum(shape.kernel)[0];
   const double tolerance_squared = tolerance * tolerance;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   WindowGains gains{shape, cv::Mat(bb.size(), CV_32FC1, cv::Scalar(nan)), cv::Mat::zeros(bb.size(), CV_32FC1),
-                    cv::Mat::zeros(bb.size(), CV_32FC1), cv::Mat::zeros(bb.size(), CV_8UC1)};
+                    cv::Mat::zeros(bb.size(), CV_32FC1)};
   for (int y = 0; y < bb.rows; ++y)
     for (int x = 0; x < bb.cols; ++x) {
       const double n = m00.at<float>(y, x);
@@ -156,55 +152,8 @@ WindowGains FitWindowGains(const cv::Mat& b, const cv::Mat& bb, const cv::Mat& a
       gains.alpha.at<float>(y, x) = static_cast<float>(theta[0]);
       gains.beta.at<float>(y, x) = static_cast<float>(theta[1]);
       gains.gamma.at<float>(y, x) = static_cast<float>(theta[2]);
-      const double variance = (n - b_sums.at<float>(y, x) / pixels) / samples;
-      gains.informative.at<uint8_t>(y, x) = theta[0] * theta[0] * variance > informative_squared;
     }
   return gains;
-}
-
-// Union-find over the shadow windows of all shapes.
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(int count) : parent(count) {
-    for (int i = 0; i < count; ++i) parent[i] = i;
-  }
-  int Find(int i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  }
-  void Join(int i, int j) { parent[Find(i)] = Find(j); }
-};
-
-// Keeps only the shadow windows whose gain is carried, through windows of similar gain
-// (adjacent, or of another shape at the same pixel), from an informative window: a gain
-// field that a textured part of the background vouches for. Flat windows (a flat object
-// over a flat patch of background fits a gain as well as a shadow does) keep their gain
-// only when it continues one that texture confirmed.
-void KeepAnchoredWindows(std::vector<WindowGains>* fitted, double similar) {
-  const int shapes = static_cast<int>(fitted->size());
-  if (shapes == 0) return;
-  const int rows = (*fitted)[0].alpha.rows, cols = (*fitted)[0].alpha.cols, count = rows * cols;
-  DisjointSets sets(shapes * count);
-  auto gain = [&](int s, int i) { return (*fitted)[s].alpha.ptr<float>()[i]; };
-  auto close = [&](float g, float h) { return std::abs(g - h) <= similar * std::max(g, h); };  // NaN: false
-  for (int s = 0; s < shapes; ++s)
-    for (int y = 0; y < rows; ++y)
-      for (int x = 0; x < cols; ++x) {
-        const int i = y * cols + x;
-        const float g = gain(s, i);
-        if (std::isnan(g)) continue;
-        if (x + 1 < cols && close(g, gain(s, i + 1))) sets.Join(s * count + i, s * count + i + 1);
-        if (y + 1 < rows && close(g, gain(s, i + cols))) sets.Join(s * count + i, s * count + i + cols);
-        for (int t = s + 1; t < shapes; ++t)
-          if (close(g, gain(t, i))) sets.Join(s * count + i, t * count + i);
-      }
-  std::vector<uint8_t> anchored(shapes * count, 0);
-  for (int s = 0; s < shapes; ++s)
-    for (int i = 0; i < count; ++i)
-      if (!std::isnan(gain(s, i)) && (*fitted)[s].informative.ptr<uint8_t>()[i]) anchored[sets.Find(s * count + i)] = 1;
-  for (int s = 0; s < shapes; ++s)
-    for (int i = 0; i < count; ++i)
-      if (!anchored[sets.Find(s * count + i)]) (*fitted)[s].alpha.ptr<float>()[i] = std::numeric_limits<float>::quiet_NaN();
 }
 
 // Of the gains the windows of `gains` lend pixel (x, y), the one nearest `own` (the gain
@@ -235,18 +184,14 @@ cv::Mat ShadowRobustDifference(const cv::Mat& image, const cv::Mat& background, 
   SlopeWeighted(image_unit, background_unit, &a, &b);
   const cv::Mat bb = SumChannels(b.mul(b)), ab = SumChannels(a.mul(b)), aa = SumChannels(a.mul(a));
   const int mode = std::getenv("SCALES") ? std::atoi(std::getenv("SCALES")) : 5;
-  const int reach = std::getenv("REACH") ? std::atoi(std::getenv("REACH")) : 2;
   std::vector<WindowShape> shapes;
-  if (mode & 1) shapes.push_back(Square(w, reach * w));
-  if (mode & 2) shapes.push_back(Square(1, reach));
+  if (mode & 1) shapes.push_back(Square(w, /*ramp=*/true));
+  if (mode & 2) shapes.push_back(Square(1, /*ramp=*/false));
   if (mode & 4)
     for (cv::Point direction : {cv::Point(1, 0), cv::Point(0, 1), cv::Point(1, 1), cv::Point(1, -1)})
       shapes.push_back(Line(w, direction));
   std::vector<WindowGains> fitted;
-  const double tolerance_factor = std::getenv("TOLF") ? std::atof(std::getenv("TOLF")) : 1.0;
-  for (const WindowShape& shape : shapes) fitted.push_back(FitWindowGains(b, bb, ab, aa, channels, tolerance_factor * tolerance, shape, options));
-  const double similar = std::getenv("SIMILAR") ? std::atof(std::getenv("SIMILAR")) : 0.1;
-  if (similar > 0) KeepAnchoredWindows(&fitted, similar);
+  for (const WindowShape& shape : shapes) fitted.push_back(FitWindowGains(bb, ab, aa, channels, tolerance, shape, options));
 
   // e(p): the misfit of p under the gain nearest its own among those lent by the shadow
   // windows around it; m = min(d, e).
