@@ -1,7 +1,6 @@
 #include "vision/silhouettes_background.h"
 
 #include <algorithm>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -87,8 +86,8 @@ struct WindowShape {
 
 // A pixel p takes gains from the windows that contain it: those centred at p − o for the
 // window's own offsets o (the windows are symmetric about their centre).
-WindowShape Square(int radius, bool ramp) {
-  WindowShape shape{radius, cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_32F), ramp, {}};
+WindowShape Square(int radius) {
+  WindowShape shape{radius, cv::Mat::ones(2 * radius + 1, 2 * radius + 1, CV_32F), true, {}};
   for (int dy = -radius; dy <= radius; ++dy)
     for (int dx = -radius; dx <= radius; ++dx) shape.neighbours.emplace_back(dx, dy);
   return shape;
@@ -183,13 +182,12 @@ cv::Mat ShadowRobustDifference(const cv::Mat& image, const cv::Mat& background, 
   cv::Mat a, b;
   SlopeWeighted(image_unit, background_unit, &a, &b);
   const cv::Mat bb = SumChannels(b.mul(b)), ab = SumChannels(a.mul(b)), aa = SumChannels(a.mul(a));
-  const int mode = std::getenv("SCALES") ? std::atoi(std::getenv("SCALES")) : 5;
-  std::vector<WindowShape> shapes;
-  if (mode & 1) shapes.push_back(Square(w, /*ramp=*/true));
-  if (mode & 2) shapes.push_back(Square(1, /*ramp=*/false));
-  if (mode & 4)
-    for (cv::Point direction : {cv::Point(1, 0), cv::Point(0, 1), cv::Point(1, 1), cv::Point(1, -1)})
-      shapes.push_back(Line(w, direction));
+  // A square whose gain may tilt (a penumbra across it), and lines of the same length in
+  // four directions: a shadow edge or a thin shadow (a leg's) is too narrow for any square
+  // to fit one gain, but lies along a line that does.
+  std::vector<WindowShape> shapes = {Square(w)};
+  for (cv::Point direction : {cv::Point(1, 0), cv::Point(0, 1), cv::Point(1, 1), cv::Point(1, -1)})
+    shapes.push_back(Line(w, direction));
   std::vector<WindowGains> fitted;
   for (const WindowShape& shape : shapes) fitted.push_back(FitWindowGains(bb, ab, aa, channels, tolerance, shape, options));
 

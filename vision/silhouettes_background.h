@@ -12,15 +12,23 @@
 //     a_c(p) = s(L^I_c(p))·L^I_c(p),   b_c(p) = s(L^I_c(p))·L^B_c(p),
 //     r_c(p; α) = a_c(p) − α·b_c(p) ≈ V^I_c(p) − sRGB(α·L^B_c(p))   (to first order),
 // the misfit of "p is the background under gain α" in encoded units, channel c.
-// For every window W(q) of (2w + 1)² pixels centred at q (w = shadow_window_radius):
-//     α(q) = clamp(Σ_W Σ_c a·b / Σ_W Σ_c b², shadow_min_gain, shadow_max_gain)
-//     R(q) = Σ_W Σ_c r_c(p; α(q))² / (C·|W|)                  (mean squared misfit)
-// A window is a shadow window when √R(q) ≤ τ (τ = the camera's threshold): one gain
-// explains the colours AND the texture of all its pixels. This is where texture counts:
-// on a textured floor, a window that the object covers is fitted by no single gain (its
-// gradients are not the background's), while a shadow's window is. The shadow-robust
-// difference of a pixel is what the best shadow window containing it leaves unexplained:
-//     e(p) = min over shadow windows W(q) ∋ p of √(Σ_c r_c(p; α(q))² / C),
+//
+// Windows. Around every pixel q: the square W(q) of (2w + 1)² pixels (w =
+// shadow_window_radius), over which the gain may tilt, g_q(p) = α + β·u + γ·v with
+// (u, v) = (p − q) / w (a penumbra crossing it), and four lines of 2w + 1 pixels through q
+// (horizontal, vertical, both diagonals) with one gain g_q = α: a sharp shadow edge or a
+// thin shadow (a leg's, a few pixels wide) is fitted by no square but lies along a line.
+// Each window's gain is the least-squares fit over its pixels and channels,
+//     θ = argmin Σ_W Σ_c r_c(p; g_q(p))²,     R(q) = that minimum / (C·|W|),
+// (window sums by correlation, a 3×3 solve per square), and the window is a shadow
+// window when α ∈ [shadow_min_gain, shadow_max_gain] and √R(q) ≤ τ (τ = the camera's
+// threshold): one gain explains the colours AND the texture of all its pixels. This is
+// where texture counts: on a textured floor, a window that the object covers is fitted by
+// no gain (its gradients are not the background's), while a shadow's window is.
+// The shadow-robust difference of a pixel is what the best shadow window containing it
+// leaves unexplained:
+//     e(p) = min over shadow windows W ∋ p of √(Σ_c r_c(p; g_W(p))² / C)
+//            (the window gain nearest p's own gain Σ_c a·b / Σ_c b²),
 //     m(p) = min(d(p), e(p)),   d(p) = the plain colour difference (BackgroundDifference).
 // Only windows that contain p and fit are used, so a background pixel next to the object
 // keeps a small e through a window on its far side (no widening of the silhouette), and a
@@ -28,7 +36,7 @@
 // What it cannot tell apart: an object of the background's colour that is darker by a
 // gain in [shadow_min_gain, 1] over a region of the background without texture (a gray
 // object on a flat gray wall looks like its shadow); a textured background tells them
-// apart.
+// apart, colour (cameras that have it) helps.
 //
 // Per-camera threshold. The pixels outside the projection of the working volume (the
 // dataset's bounds, grown by working_volume_margin) cannot show the object: their plain
