@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 namespace subflow::cli {
 
@@ -17,6 +18,16 @@ struct Command {
 };
 
 using AddCommandFunction = Command (*)(CLI::App&);
+
+// Every option of `command` as the command line gave it, by its long name (positionals by
+// their name): {"IN": "base.ply", "--levels": "2", "--limit": true, "--out": "x.ply"}.
+// A value is the text given (a list when given several times or with several values), a
+// switch true or false; an option not given records its default as --help shows it, or
+// null. Built from CLI11's own record of the parse, so no flag can be left out.
+nlohmann::json ArgumentsJson(const CLI::App& command);
+// ArgumentsJson of the subcommand being run (set by RunSelected before it runs): every
+// command records it in its report as "arguments".
+const nlohmann::json& InvocationArguments();
 
 Command AddCheckCommand(CLI::App& app);  // cli/check_command.cpp
 Command AddSynthCommand(CLI::App& app);  // cli/synth_command.cpp

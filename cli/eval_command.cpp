@@ -20,12 +20,14 @@
 #include "solver/rigid/rigid_motion.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
+#include "vision/evaluation_maps.h"
 
 namespace subflow::cli {
 namespace {
 
 struct EvalSettings {
   std::string dataset, result, json_path;
+  std::string error_maps;  // --error-maps DIR: per-vertex error maps (vision/evaluation_maps.h)
   bool overwrite = false;
   vision::EvaluationOptions options;
   bool hull = false;  // score RESULT/hull/ (visual hulls) instead of RESULT/meshes/
@@ -80,8 +82,56 @@ nlohmann::json RigidComparison(const std::string& dataset_directory, const std::
   return steps;
 }
 
+// Writes DIR/result and DIR/truth, each a result folder (meshes/<frame>.ply with the vertex
+// properties error (signed distance), distance (|error|) and views, and report.json naming
+// the dataset) that `subflow render --colour-by distance` pictures.
+void WriteErrorMaps(const EvalSettings& settings, const vision::EvaluationReport& report) {
+  namespace fs = std::filesystem;
+  const std::string surfaces = settings.hull ? "hull" : "meshes";
+  int first = 0;
+  const std::vector<std::string> result_paths =
+      vision::ListFrameMeshes((fs::path(settings.result) / surfaces).string(), &first);
+  const std::vector<std::string> truth_paths =
+      vision::ListFrameMeshes((fs::path(settings.dataset) / "groundtruth" / "mesh").string());
+  const fs::path cameras_path = fs::path(settings.dataset) / "cameras.json";
+  const std::vector<vision::Camera> cameras =
+      fs::exists(cameras_path) ? vision::ReadCamerasJson(cameras_path.string()) : std::vector<vision::Camera>();
+  geometry::MeshReadOptions read_options;
+  read_options.require_manifold = false;
+  for (const char* side : {"result", "truth"}) fs::create_directories(fs::path(settings.error_maps) / side / "meshes");
+  auto write = [&](const char* side, int frame, const geometry::TriangleMesh& mesh, const vision::SurfaceErrorMap& map) {
+    geometry::VertexProperties properties;
+    properties.names = {"error", "distance", "views"};
+    properties.values["error"] = map.error;
+    properties.values["distance"] = map.error.cwiseAbs();
+    properties.values["views"] = map.views.cast<double>();
+    geometry::WriteMesh((fs::path(settings.error_maps) / side / "meshes" / (vision::FrameName(frame) + ".ply")).string(),
+                        mesh, &properties);
+  };
+  for (std::size_t i = 0; i < result_paths.size(); ++i) {
+    const int frame = first + static_cast<int>(i);
+    const geometry::TriangleMesh truth = geometry::ReadMesh(truth_paths.at(frame), read_options);
+    const geometry::TriangleMesh result = geometry::ReadMesh(result_paths[i], read_options);
+    const vision::FrameErrorMaps maps = vision::ComputeErrorMaps(truth, result, cameras, report.visibility_tolerance);
+    write("result", frame, result, maps.result);
+    write("truth", frame, truth, maps.truth);
+  }
+  for (const char* side : {"result", "truth"})
+    output::WriteJsonFile((fs::path(settings.error_maps) / side / "report.json").string(),
+                          {{"command", "eval --error-maps"},
+                           {"side", side},
+                           {"result", settings.result},
+                           {"surfaces", surfaces},
+                           {"dataset", {{"directory", fs::absolute(settings.dataset).string()}}},
+                           {"visibility_tolerance", report.visibility_tolerance}});
+}
+
 void RunEval(const EvalSettings& settings) {
   if (!settings.json_path.empty()) output::CheckOutputFile(settings.json_path, settings.overwrite, "--json");
+  if (!settings.error_maps.empty()) {
+    output::PrepareOutputDirectory(settings.error_maps, settings.overwrite);
+    for (const char* side : {"result", "truth"}) std::filesystem::remove_all(std::filesystem::path(settings.error_maps) / side);
+  }
   ProgressBar progress;
   const vision::EvaluationReport report =
       vision::EvaluateReconstruction(settings.dataset, settings.result, settings.options, &progress,
@@ -102,8 +152,11 @@ void RunEval(const EvalSettings& settings) {
   if (!settings.json_path.empty()) {
     nlohmann::json json = nlohmann::json::parse(report.Json());
     json["rigid_motion"] = rigid;
+    json["command"] = "eval";
+    json["arguments"] = InvocationArguments();
     output::WriteJsonFile(settings.json_path, json);
   }
+  if (!settings.error_maps.empty()) WriteErrorMaps(settings, report);
 }
 
 }  // namespace
@@ -117,7 +170,11 @@ Command AddEvalCommand(CLI::App& app) {
   command->add_option("result", settings->result, "Result directory (with meshes/)")->required();
   command->add_option("--json", settings->json_path,
                       "Also write the figures to this JSON file (an existing file is refused without --overwrite)");
-  command->add_flag("--overwrite", settings->overwrite, "Replace the --json file if it exists");
+  command->add_flag("--overwrite", settings->overwrite, "Replace the --json file / --error-maps folder if it exists");
+  command->add_option("--error-maps", settings->error_maps,
+                      "Also write per-vertex error maps to this folder: result/ and truth/, result folders whose "
+                      "meshes carry error (signed distance to the other surface), distance and views; "
+                      "picture them with `subflow render DIR/truth --colour-by distance`");
   command->add_option("--threshold", settings->options.threshold,
                       "Completeness distance (world units); 0 = 1 % of the true bounding-box diagonal")
       ->capture_default_str();

@@ -123,6 +123,7 @@ void RunExport(const ExportArguments& arguments) {
       sequence ? (fs::path(arguments.out) / "report.json").string() : arguments.out + ".report.json";
   if (!sequence) output::CheckOutputFile(report_path, true, "");
   output::WriteJsonFile(report_path, {{"command", "export"},
+                                      {"arguments", InvocationArguments()},
                                       {"versions", output::VersionsJson()},
                                       {"result", arguments.result},
                                       {"format", format},

@@ -51,6 +51,7 @@ nlohmann::json ImportReport(const ImportArguments& arguments, const vision::Data
                        {"media_frames", camera.media_frames}});
   const vision::DatasetImportOptions& o = arguments.options;
   return {{"command", "import"},
+          {"arguments", InvocationArguments()},
           {"format", arguments.format},
           {"source", arguments.source},
           {"options",

@@ -37,7 +37,8 @@ void RunPlan(const PlanArguments& arguments) {
   arguments.plan.Check();
   const vision::Dataset dataset(arguments.dataset);
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
-  const nlohmann::json plan = output::WritePlan(arguments.dataset, dataset, options, arguments.plan, arguments.out);
+  const nlohmann::json plan = output::WritePlan(arguments.dataset, dataset, options, arguments.plan, arguments.out,
+                                                InvocationArguments());
   spdlog::info("plan: {} tasks over frames {} in {} chunks written to {}{}", plan["tasks"].size(),
                plan["frames"].dump(), plan["chunks"].get<int>(), arguments.out,
                arguments.plan.slurm ? " (sbatch scripts in slurm/, submit with slurm/submit.sh)" : "");

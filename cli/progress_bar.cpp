@@ -14,7 +14,7 @@ void ProgressBar::Begin(const std::string& stage, std::size_t total) {
   total_ = total;
   done_ = 0;
   last_printed_decile_ = -1;
-  start_ = std::chrono::steady_clock::now();
+  stopwatch_.Restart();
   Draw(false);
 }
 
@@ -31,8 +31,7 @@ void ProgressBar::End() {
 }
 
 void ProgressBar::Draw(bool final_line) {
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double seconds = stopwatch_.Seconds();
   const double fraction = total_ > 0 ? static_cast<double>(done_) / total_ : 0.0;
   if (!interactive_ && !final_line) {
     // The complete line is End's alone: printing it here too (when an Update reaches the

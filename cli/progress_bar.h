@@ -2,12 +2,12 @@
 // place on a terminal, printed at 10 % steps otherwise (logs stay readable in CI).
 #pragma once
 
-#include <chrono>
 #include <cstddef>
 #include <mutex>
 #include <string>
 
 #include "core/progress.h"
+#include "core/stopwatch.h"
 
 namespace subflow::cli {
 
@@ -27,7 +27,7 @@ class ProgressBar : public Progress {
   std::size_t total_ = 0;
   std::size_t done_ = 0;
   int last_printed_decile_ = -1;
-  std::chrono::steady_clock::time_point start_;
+  Stopwatch stopwatch_;
 };
 
 }  // namespace subflow::cli

@@ -33,8 +33,8 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite, arguments.resume);
   ProgressBar progress;
   const std::string command = arguments.stages.no_refine ? "reconstruct --no-refine" : "reconstruct";
-  const nlohmann::json stages = output::RunReconstruction({command, arguments.out, arguments.overwrite, arguments.resume}, dataset,
-                                                          options, arguments.resume, &progress, start);
+  const output::CommandRun run{command, arguments.out, arguments.overwrite, arguments.resume, InvocationArguments()};
+  const nlohmann::json stages = output::RunReconstruction(run, dataset, options, arguments.resume, &progress, start);
   spdlog::info("reconstruct: written to {} in {:.1f} s (stages: {})", arguments.out, start.Seconds(), stages.dump());
 }
 

@@ -46,6 +46,7 @@ void RunRender(const RenderArguments& arguments) {
       output::RenderResultPictures(result, dataset.get(), metadata, arguments.out, options, &progress);
   nlohmann::json report = summary.Json();
   report["command"] = "render";
+  report["arguments"] = InvocationArguments();
   report["versions"] = output::VersionsJson();
   report["result"] = arguments.result;
   report["dataset"] = metadata.dataset_directory;
@@ -83,6 +84,11 @@ Command AddRenderCommand(CLI::App& app) {
   command->add_flag("--mp4", options.mp4, "Also an MP4 of the overlays per camera (every frame)");
   command->add_option("--fps", arguments->fps, "MP4 frame rate (default: the result's)");
   command->add_flag("--overwrite", arguments->overwrite, "Write into a non-empty output directory");
+  command->add_option("--colour-by", options.colour_by,
+                      "Colour by this scalar vertex property instead of the flows (e.g. distance of "
+                      "`subflow eval --error-maps`)");
+  command->add_option("--colour-range", options.colour_range, "MIN,MAX of the --colour-by scale (world units)")
+      ->delimiter(',')->expected(2);
   command->footer("Example: subflow render out/result --out out/pictures --frames 0,12,23 --mp4");
   return {command, [arguments] { RunRender(*arguments); }};
 }

@@ -67,8 +67,8 @@ void RunStageCommand(solver::Stage stage, const std::string& name, const StageAr
   }
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
   ProgressBar progress;
-  output::RunStage(stage, {name, arguments.out, arguments.overwrite}, dataset, options, in ? &*in : nullptr,
-                   arguments.out, &progress);
+  const output::CommandRun run{name, arguments.out, arguments.overwrite, false, InvocationArguments()};
+  output::RunStage(stage, run, dataset, options, in ? &*in : nullptr, arguments.out, &progress);
   spdlog::info("{}: stage folder written to {}", name, arguments.out);
 }
 
@@ -124,7 +124,8 @@ void RunSplit(const SplitArguments& arguments) {
   const nlohmann::json options = last.report.value("options", nlohmann::json::object());
   nlohmann::json stages = nlohmann::json::object();
   for (const auto& [section, ignored] : options.items()) stages[section] = "loaded";
-  output::WriteReconstruction({"split", arguments.out, arguments.overwrite}, dataset, options, last, stages, start);
+  const output::CommandRun run{"split", arguments.out, arguments.overwrite, false, InvocationArguments()};
+  output::WriteReconstruction(run, dataset, options, last, stages, start);
   spdlog::info("split: {} frames written to {} in {:.1f} s", last.state.frame_count(), arguments.out,
                start.Seconds());
 }
@@ -137,8 +138,8 @@ struct MergeArguments {
 
 void RunMerge(const MergeArguments& arguments) {
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
-  const nlohmann::json merged =
-      output::MergeStageFolders({"merge", arguments.out, arguments.overwrite}, arguments.inputs, arguments.out);
+  const output::CommandRun run{"merge", arguments.out, arguments.overwrite, false, InvocationArguments()};
+  const nlohmann::json merged = output::MergeStageFolders(run, arguments.inputs, arguments.out);
   spdlog::info("merge: {} stage folders, frames {}, written to {}", arguments.inputs.size(), merged["frames"].dump(),
                arguments.out);
 }

@@ -43,11 +43,28 @@ void AddFramesOption(CLI::App* sub, int* first, int* count, bool allow_count) {
 
 void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string* evidence) {
   sub->add_option("--evidence", *evidence,
-                  "Object evidence: auto (masks, else background, else motion), mask, background, motion")
+                  "Object evidence: auto (masks, else background, else motion (with what stands still), else "
+                  "still: photo-consistency of the reference frame), mask, background, motion, still")
       ->capture_default_str();
-  sub->add_option("--levels", o->levels, "Subdivision levels above the base mesh")->capture_default_str();
-  sub->add_option("--base-faces", o->simplify.target_face_count, "Faces of the base mesh T0")
-      ->capture_default_str();
+  sub->add_option("--levels", o->levels,
+                  "Subdivision levels above the base mesh (-1 = automatic: finest edges about "
+                  "--finest-edge-pixels where the subject is smooth)")
+      ->capture_default_str()->check(CLI::Range(-1, 6));
+  sub->add_option("--finest-edge-pixels", o->finest_edge_pixels,
+                  "Projected length of the finest level's edges the automatic levels aim at, in [0.25, 1000]")
+      ->capture_default_str()->check(CLI::Range(0.25, 1000.0));
+  sub->add_option("--base-distance", o->base_distance_voxels,
+                  "The base mesh T0 stays within this many voxels of the reference hull, both ways: the "
+                  "subject's detail sets its faces (0 = by count, --base-faces)")
+      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
+  sub->add_option_function<int>(
+         "--base-faces",
+         [o](int faces) {
+           o->simplify.target_face_count = faces;
+           o->base_distance_voxels = 0;
+         },
+         "Faces of the base mesh T0, by count instead of the distance bound (--base-distance 0)")
+      ->default_str(std::to_string(o->simplify.target_face_count))->check(CLI::Range(4, 100000000));
   sub->add_option("--reference-frame", o->reference_frame,
                   "Frame giving the base connectivity (-1 = middle frame)")->capture_default_str();
   sub->add_option("--first-frame", o->first_frame, "First frame to process")->capture_default_str();
@@ -108,6 +125,9 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
       ->capture_default_str();
   sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
   sub->add_option("--iterations", o->solver.max_iterations, "Ceres iterations per window and round")
+      ->capture_default_str();
+  sub->add_option("--function-tolerance", o->solver.function_tolerance,
+                  "A window's solve ends when an iteration lowers the cost by less than this fraction")
       ->capture_default_str();
   sub->add_option_function<std::string>(
          "--linear-solver",

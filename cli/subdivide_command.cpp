@@ -1,7 +1,7 @@
 // `subflow subdivide IN --levels N [--limit] --out OUT`: Loop-subdivides a triangle mesh
 // N times (geometry/loop_hierarchy.h) and writes the control mesh of level N, or with
-// --limit its vertices pushed to their limit positions on the Loop surface.
-#include <chrono>
+// --limit its vertices pushed to their limit positions on the Loop surface. Writes
+// OUT.report.json beside it (last).
 #include <iostream>
 #include <memory>
 #include <string>
@@ -10,10 +10,13 @@
 
 #include "cli/commands.h"
 #include "core/error.h"
+#include "core/stopwatch.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/mesh_io.h"
 #include "geometry/unused_vertices.h"
 #include "output/overwrite_guard.h"
+#include "output/report.h"
+#include "output/result_writer.h"
 
 namespace subflow::cli {
 namespace {
@@ -27,8 +30,10 @@ struct SubdivideSettings {
 };
 
 void RunSubdivide(const SubdivideSettings& settings) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
+  const std::string report_path = settings.output_path + ".report.json";
   output::CheckOutputFile(settings.output_path, settings.overwrite, "--out");
+  output::CheckOutputFile(report_path, settings.overwrite, "--out");
   geometry::TriangleMesh base = geometry::ReadMesh(settings.input_path);
   if (const int unused = geometry::RemoveUnusedVertices(&base))
     spdlog::warn("{}: {} vertices referenced by no face are left out; the others keep their order",
@@ -41,8 +46,20 @@ void RunSubdivide(const SubdivideSettings& settings) {
     result.V = geometry::MultiplyPoints(hierarchy.LimitPositions(settings.levels), result.V);
   result.F = hierarchy.LevelFaces(settings.levels);
   geometry::WriteMesh(settings.output_path, result);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = stopwatch.Seconds();
+  output::WriteJsonFile(report_path, {{"command", "subdivide"},
+                                      {"arguments", InvocationArguments()},
+                                      {"versions", output::VersionsJson()},
+                                      {"input", {{"path", settings.input_path},
+                                                 {"vertices", base.vertex_count()},
+                                                 {"faces", base.face_count()},
+                                                 {"closed", hierarchy.Topology(0).IsClosed()}}},
+                                      {"output", {{"path", settings.output_path},
+                                                  {"vertices", result.vertex_count()},
+                                                  {"faces", result.face_count()}}},
+                                      {"levels", settings.levels},
+                                      {"limit", settings.limit},
+                                      {"seconds", seconds}});
   std::cout << settings.input_path << ": " << base.vertex_count() << " vertices, "
             << base.face_count() << " faces"
             << (hierarchy.Topology(0).IsClosed() ? "" : " (open)") << "\n"
@@ -72,7 +89,8 @@ Command AddSubdivideCommand(CLI::App& app) {
                     "Move the final vertices onto the limit surface (Loop's limit masks) "
                     "instead of writing the control points");
   command->add_option("--out,-o", settings->output_path,
-                      "Output mesh (.ply or .obj); an existing file is refused without --overwrite")
+                      "Output mesh (.ply or .obj), with OUT.report.json beside it; an existing file is refused without "
+                      "--overwrite")
       ->required();
   command->add_flag("--overwrite", settings->overwrite, "Replace the output mesh if it exists");
   command->footer(

@@ -98,6 +98,7 @@ Command AddSynthCommand(CLI::App& app) {
             // Last, so that a dataset folder without it is visibly unfinished.
             output::WriteJsonFile(*out + "/report.json",
                                   {{"command", "synth"},
+                                   {"arguments", InvocationArguments()},
                                    {"versions", output::VersionsJson()},
                                    {"scene", options->scene.scene},
                                    {"rig", options->rig.rig},

@@ -46,6 +46,7 @@ void RunView(const ViewArguments& arguments) {
   const output::ViewerSummary summary =
       output::WriteViewer(result, dataset.get(), metadata, arguments.out, options, &progress);
   output::WriteJsonFile(arguments.out + ".report.json", {{"command", "view"},
+                                                         {"arguments", InvocationArguments()},
                                                          {"versions", output::VersionsJson()},
                                                          {"result", arguments.result},
                                                          {"dataset", metadata.dataset_directory},

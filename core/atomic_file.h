@@ -4,6 +4,12 @@
 // once complete. An AtomicFile destroyed before Commit() — an error, an interruption
 // (core/interrupt.h) — removes its temporary. A process killed outright (SIGKILL) can
 // leave a ".<name>.partial", visibly unfinished; never a file with the final name.
+// Commit() also makes the file durable before it counts as written: the temporary's data
+// are flushed to the disk (fsync) before the rename, and the directory after it, so that
+// after a crash of the machine (power loss) the final name holds the complete file or
+// nothing — never an empty or partial file, which a rename alone allows on ext4 / XFS
+// with delayed allocation. A report.json committed last is thus never durable before the
+// files it describes.
 //
 // The one mechanism for every file subflow writes:
 //   AtomicFile file(path);                       // a stream
@@ -15,6 +21,9 @@
 //   writer.open(file.temporary(), ...); ... writer.release();
 //   file.Commit();
 #pragma once
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -68,9 +77,12 @@ class AtomicFile {
     }
     if (!std::filesystem::is_regular_file(temporary_, error))
       ThrowError(path_, "", "was not written (no \"" + temporary_ + "\")");
+    Sync(temporary_, false);
     std::filesystem::rename(temporary_, path_, error);
     if (error) ThrowError(path_, "", "cannot rename \"" + temporary_ + "\" into place: " + error.message());
     committed_ = true;
+    const std::filesystem::path directory = std::filesystem::path(path_).parent_path();
+    Sync(directory.empty() ? "." : directory.string(), true);
   }
 
   // ".<name>.partial", or ".<stem>.partial<.ext>" with kKeepExtension, in path's directory.
@@ -83,6 +95,19 @@ class AtomicFile {
   }
 
  private:
+  // fsync of the file or directory `path`: its data (a file) or its entries (a directory)
+  // on the disk. Throws subflow::Error naming path() when the disk reports an error; a
+  // file system that cannot sync (EINVAL, EROFS: /proc, some FUSE mounts) is no error.
+  void Sync(const std::string& path, bool directory) const {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | (directory ? O_DIRECTORY : 0));
+    if (fd < 0) ThrowError(path_, "", "cannot open \"" + path + "\" to flush it: " + std::strerror(errno));
+    const int status = ::fsync(fd);
+    const int error = errno;
+    ::close(fd);
+    if (status != 0 && error != EINVAL && error != EROFS)
+      ThrowError(path_, "", "cannot flush \"" + path + "\" to the disk: " + std::strerror(error));
+  }
+
   std::string path_, temporary_;
   std::ofstream stream_;
   bool committed_ = false;

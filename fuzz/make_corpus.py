@@ -128,7 +128,7 @@ def main():
             files.append(("masks/%s/%06d.png" % (cam, frame), png(w, h, 1, 8, lambda x, y, c: 255 if 2 < x < 6 else 0)))
         files.append(("background/%s.png" % cam, png(w, h, channels, 8, lambda x, y, c: 10)))
     write("dataset_layout_fuzzer", "images_masks_background", tree(files))
-    files = [("cameras.json", cameras_json(["a"], w, h, bounds=False))]
+    files = [("cameras.json", cameras_json(["a"], w, h, bounds=True))]
     files += [("images/a/%06d.png" % f, png(w, h, 4)) for f in range(3)]
     files += [("groundtruth/mesh/%06d.ply" % f, ply_ascii(TETRA_V, TETRA_F)) for f in range(3)]
     write("dataset_layout_fuzzer", "rgba_groundtruth", tree(files))
@@ -157,6 +157,38 @@ def main():
     write("calibration_fuzzer", "panoptic_json", tree([("calibration.json", json.dumps({"cameras": [
         {"name": "00_00", "type": "hd", "resolution": [64, 48], "K": [[50, 0, 32], [0, 50, 24], [0, 0, 1]],
          "distCoef": [0.01, 0, 0, 0, 0], "R": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "t": [[0], [0], [200]]}]}))]))
+    # COLMAP's binary model (cameras.bin, images.bin), little-endian as COLMAP writes it.
+    cameras_bin = struct.pack("<Q", 2)
+    cameras_bin += struct.pack("<IiQQ4d", 1, 1, 64, 48, 50, 52, 32, 24)  # PINHOLE
+    cameras_bin += struct.pack("<IiQQ4d", 2, 2, 64, 48, 50, 32, 24, 0.01)  # SIMPLE_RADIAL
+    images_bin = struct.pack("<Q", 2)
+    images_bin += struct.pack("<I4d3dI", 1, 1, 0, 0, 0, 0, 0, 2, 1) + b"cam00/000000.png\0"
+    images_bin += struct.pack("<Q", 1) + struct.pack("<ddq", 10, 20, -1)
+    images_bin += struct.pack("<I4d3dI", 2, 0.7071, 0, 0.7071, 0, 0.1, 0, 2, 2) + b"cam01/000000.png\0"
+    images_bin += struct.pack("<Q", 0)
+    # (without tree()'s last newline: the last block runs to the end of the seed)
+    write("calibration_fuzzer", "colmap_binary", tree([("cameras.bin", cameras_bin), ("images.bin", images_bin)])[:-1])
+    # Qualisys .qca.txt (XML, QTM's 1/64-pixel units) and EasyMocap intri.yml / extri.yml.
+    fov = ' bottom="767" left="0" right="1023" top="0"/>\n'
+    write("calibration_fuzzer", "qualisys_qca", tree([("Calib.qca.txt",
+        "<?xml version='1.0' encoding='ASCII'?>\n<calibration created=\"x\" qtm-version=\"none\" source=\"t\" type=\"regular\">\n"
+        '  <results min-max-diff="0." std-dev="0."/>\n  <cameras>\n'
+        '    <camera active="1" avg-residual="0.4" model="Miqus Video" point-count="99" serial="12345" viewrotation="0">\n'
+        "      <fov_marker" + fov + "      <fov_marker_max" + fov + "      <fov_video" + fov + "      <fov_video_max" + fov +
+        '      <transform r11="1" r12="0" r13="0" r21="0" r22="-1" r23="0" r31="0" r32="0" r33="-1" x="0" y="0" z="2000"/>\n'
+        '      <intrinsic centerPointU="32768" centerPointV="24576" focalLengthU="51200" focalLengthV="51200" focallength="9.3"'
+        ' radialDistortion1="0.64" radialDistortion2="0" radialDistortion3="0" sensorMaxU="65536" sensorMaxV="49152"'
+        ' sensorMinU="0" sensorMinV="0" skew="0" tangentalDistortion1="0" tangentalDistortion2="0"/>\n'
+        "    </camera>\n  </cameras>\n</calibration>\n")]))
+    def yml_matrix(key, rows, cols, values):
+        return (f"{key}: !!opencv-matrix\r\n  rows: {rows}\r\n  cols: {cols}\r\n  dt: d\r\n  data: ["
+                + ", ".join(f"{v:.6f}" for v in values) + "]\r\n")
+    names = '%YAML:1.0\r\n---\r\nnames:\r\n  - "01"\r\n'
+    write("calibration_fuzzer", "easymocap_yml", tree([
+        ("intri.yml", names + yml_matrix("K_01", 3, 3, [50, 0, 32, 0, 50, 24, 0, 0, 1]) +
+         yml_matrix("dist_01", 1, 5, [0.01, 0, 0, 0, 0]) + "H_01: 48\r\nW_01: 64\r\n"),
+        ("extri.yml", names + yml_matrix("R_01", 3, 1, [0, 0, 0]) +
+         yml_matrix("Rot_01", 3, 3, [1, 0, 0, 0, 1, 0, 0, 0, 1]) + yml_matrix("T_01", 3, 1, [0, 0, 2]))]))
     # A result folder (result_reader_fuzzer): two frames with flow, and a report.
     flow = ply_ascii(TETRA_V, TETRA_F).replace("property float z\n", "property float z\nproperty float vx\nproperty float vy\nproperty float vz\n")
     flow = flow.replace("0 0 0\n1 0 0\n0 1 0\n0 0 1\n", "0 0 0 0.1 0 0\n1 0 0 0.1 0 0\n0 1 0 0.1 0 0\n0 0 1 0.1 0 0\n")

@@ -4,13 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <string>
+#include <type_traits>
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/internal/Side_of_triangle_mesh/Point_inside_vertical_ray_cast.h>
+#include <boost/heap/priority_queue.hpp>
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
@@ -41,6 +45,82 @@ void ParallelRows(Eigen::Index count, Function&& function) {
                     [&](const tbb::blocked_range<Eigen::Index>& range) {
                       for (Eigen::Index i = range.begin(); i != range.end(); ++i) function(i);
                     });
+}
+
+// CGAL's first_intersection of a ray (AABB_ray_intersection: boxes visited in the order of
+// their entry parameter, leaves intersected, until the next box lies beyond the best hit),
+// stopped at the first box entered at or beyond `cap`. Up to `cap` the same nodes are
+// visited in the same order with the same arithmetic, so a hit whose parameter is below
+// `cap` is exactly the one the full traversal returns; a ray that misses near its origin
+// no longer walks every box to the far side of the mesh.
+boost::optional<Tree::Intersection_and_primitive_id<Ray3>::Type> FirstIntersectionBefore(const Tree& tree,
+                                                                                       const Ray3& ray, double cap) {
+  if (tree.size() < 2 || !(cap > 0.0)) return tree.first_intersection(ray);
+  const Traits& traits = tree.traits();
+  if (!traits.do_intersect_object()(ray, tree.root_node()->bbox())) return boost::none;
+  using Node = std::remove_const_t<std::remove_pointer_t<decltype(tree.root_node())>>;  // Tree::Node is private
+  struct Entry {
+    const Node* node;
+    std::size_t primitives;
+    double value;
+    bool operator>(const Entry& other) const { return value > other.value; }
+  };
+  boost::heap::priority_queue<Entry, boost::heap::compare<std::greater<Entry>>> heap;
+  const auto intersect = traits.intersection_object();
+  const auto entry_parameter = traits.intersection_distance_object();
+  // The parameter of a point of the ray along its largest direction component (CGAL's
+  // as_ray_param_visitor); a segment (the ray in a triangle's plane) by its nearer end.
+  const Vector3 v = ray.to_vector();
+  int largest = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(v[i]) > std::abs(v[largest])) largest = i;
+  struct Parameter : boost::static_visitor<double> {
+    const Ray3* ray;
+    Vector3 v;
+    int largest;
+    double operator()(const Point3& point) const { return Vector3(ray->source(), point)[largest] / v[largest]; }
+    double operator()(const Kernel::Segment_3& segment) const {
+      return std::min((*this)(segment[0]), (*this)(segment[1]));
+    }
+  } parameter;
+  parameter.ray = &ray;
+  parameter.v = v;
+  parameter.largest = largest;
+
+  boost::optional<Tree::Intersection_and_primitive_id<Ray3>::Type> best;
+  double t = std::numeric_limits<double>::max();
+  auto try_primitive = [&](const Primitive& primitive) {
+    const auto hit = intersect(ray, primitive);
+    if (!hit) return;
+    const double distance = boost::apply_visitor(parameter, hit->first);
+    if (distance < t) {
+      t = distance;
+      best = hit;
+    }
+  };
+  auto push = [&](const Node& child, std::size_t primitives) {  // all of them, as CGAL (same heap order)
+    if (const auto entry = entry_parameter(ray, child.bbox())) heap.push(Entry{&child, primitives, *entry});
+  };
+  heap.push(Entry{tree.root_node(), tree.size(), 0.0});
+  while (!heap.empty() && heap.top().value < std::min(t, cap)) {
+    const Entry current = heap.top();
+    heap.pop();
+    switch (current.primitives) {
+      case 2:  // two leaves
+        try_primitive(current.node->left_data());
+        try_primitive(current.node->right_data());
+        break;
+      case 3:  // a leaf and an inner node
+        try_primitive(current.node->left_data());
+        push(current.node->right_child(), 2);
+        break;
+      default:
+        push(current.node->left_child(), current.primitives / 2);
+        push(current.node->right_child(), current.primitives - current.primitives / 2);
+        break;
+    }
+  }
+  return best;
 }
 
 }  // namespace
@@ -75,11 +155,17 @@ struct ClosestPointTree::Impl {
     return face_of_triangle[static_cast<std::size_t>(it - triangles.cbegin())];
   }
 
-  RayHit Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& unit_direction) const {
+  // Hits at a ray parameter up to `max_t` (world units along the unit direction): the
+  // first one, as CGAL's first_intersection finds it; beyond max_t, none or any.
+  RayHit Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& unit_direction,
+              double max_t = std::numeric_limits<double>::infinity()) const {
     RayHit result;
     const Ray3 ray(ToPoint(origin), Vector3(unit_direction.x(), unit_direction.y(),
                                             unit_direction.z()));
-    const auto intersection = tree.first_intersection(ray);
+    // The traversal's box and hit parameters and the dot product below differ by rounding
+    // (~1e-15 relative): explore a little beyond max_t.
+    const auto intersection = std::isfinite(max_t) ? FirstIntersectionBefore(tree, ray, max_t * (1.0 + 1e-9))
+                                                   : tree.first_intersection(ray);
     if (!intersection) return result;
     Eigen::Vector3d point;
     if (const Point3* p = boost::get<Point3>(&intersection->first)) {
@@ -165,7 +251,7 @@ RayHit ClosestPointTree::FirstHit(const Eigen::Vector3d& origin, const Eigen::Ve
                                   double max_t) const {
   const double norm = direction.norm();
   if (!(norm > 0.0) || !origin.allFinite() || !direction.allFinite()) return {};
-  RayHit hit = impl_->Cast(origin, direction / norm);
+  RayHit hit = impl_->Cast(origin, direction / norm, max_t);
   if (hit.hit && hit.t > max_t) return {};
   return hit;
 }
@@ -176,8 +262,8 @@ RayHit ClosestPointTree::NearestHitOnLine(const Eigen::Vector3d& origin,
   const double norm = direction.norm();
   if (!(norm > 0.0) || !origin.allFinite() || !direction.allFinite()) return {};
   const Eigen::Vector3d unit = direction / norm;
-  RayHit forward = impl_->Cast(origin, unit);
-  RayHit backward = impl_->Cast(origin, -unit);
+  RayHit forward = impl_->Cast(origin, unit, max_abs_t);
+  RayHit backward = impl_->Cast(origin, -unit, max_abs_t);
   if (backward.hit) backward.t = -backward.t;
   RayHit best;
   if (forward.hit && forward.t <= max_abs_t) best = forward;

@@ -57,12 +57,8 @@ class LoopHierarchy {
   bool IsOddVertex(int level, int vertex) const;
   // The two level−1 endpoints of the edge on which odd `vertex` of `level` was inserted.
   std::array<int, 2> ParentEdge(int level, int vertex) const;
-  // The odd vertex of level + 1 inserted on edge e of `level`.
-  int EdgeVertexOfNextLevel(int level, int edge) const { return VertexCount(level) + edge; }
 
   static int ChildFace(int face, int k) { return 4 * face + k; }
-  static int ParentFace(int face) { return face / 4; }
-  static int ChildIndex(int face) { return face % 4; }
   static Eigen::Vector3d ChildToParentBarycentric(int child_index, const Eigen::Vector3d& w);
   // The child of a face holding the point with parent barycentrics u, and its barycentrics
   // there (ties go to the corner children; u must be a convex combination).

@@ -57,7 +57,6 @@ class MeshTopology {
   int HalfedgeOpposite(int h) const { return faces_[3 * (h / 3) + (h % 3 + 2) % 3]; }
   // The half-edge running the other way on the neighbouring face, or −1 on the boundary.
   int HalfedgeTwin(int h) const { return halfedge_twin_[h]; }
-  int HalfedgeEdge(int h) const { return halfedge_edge_[h]; }
 
   // Undirected edges, numbered in order of first appearance over the half-edges.
   int EdgeVertex(int e, int i) const { return edge_vertices_[2 * e + i]; }

@@ -450,6 +450,11 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
         const Property& property = element.properties[p];
         if (!property.is_list) {
           const double value = body.Scalar(property.type, property.name);
+          if (!std::isfinite(value))  // any element, any property: NaN / Inf is no data
+            ThrowError(source, body.Where(),
+                       (is_vertex && vertex_role[p] >= 0 && vertex_role[p] < 3 ? "coordinate " + property.name
+                                                                               : "property \"" + property.name + "\"") +
+                           " is " + (std::isnan(value) ? "NaN" : "infinite") + " (expected a finite number)");
           if (is_vertex && vertex_role[p] >= 0) {
             if (vertex_role[p] < 3)
               mesh.V(i, vertex_role[p]) = value;
@@ -487,14 +492,6 @@ TriangleMesh ReadBody(Body& body, const Header& header, const std::string& bytes
       }
       body.End();
       SUBFLOW_CHECK(!is_face || have_corners, "face without corners");
-      if (is_vertex) {
-        for (int axis = 0; axis < 3; ++axis)
-          if (!std::isfinite(mesh.V(i, axis)))
-            ThrowError(source, body.Where(),
-                       std::string("coordinate ") + kAxes[axis] + " is " +
-                           (std::isnan(mesh.V(i, axis)) ? "NaN" : "infinite") +
-                           " (expected a finite number)");
-      }
     }
   }
   body.Finish();

@@ -1,12 +1,12 @@
 // CGAL is confined to this file (heavy headers).
 #include <algorithm>
-#include <chrono>
 #include <iterator>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
+#include "core/stopwatch.h"
 #include "geometry/self_intersections.h"
 
 namespace subflow::geometry {
@@ -36,7 +36,7 @@ bool ToSurfaceMesh(const TriangleMesh& mesh, SurfaceMesh* surface, int* failed_f
 }  // namespace
 
 SelfIntersectionResult FindSelfIntersectionsCgal(const TriangleMesh& mesh, int max_example_pairs) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
   SelfIntersectionResult result;
   result.method = "CGAL";
   for (int f = 0; f < mesh.face_count(); ++f)
@@ -84,7 +84,7 @@ SelfIntersectionResult FindSelfIntersectionsCgal(const TriangleMesh& mesh, int m
       std::unique(result.intersecting_faces.begin(), result.intersecting_faces.end()),
       result.intersecting_faces.end());
   result.reported_face_count = static_cast<int>(result.intersecting_faces.size());
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = stopwatch.Seconds();
   return result;
 }
 

@@ -6,7 +6,9 @@
 // Garland–Heckbert plane quadrics for cost and placement: the cost of contracting edge
 // (v0, v1) to the point p is pᵀ(Q0 + Q1)p, where Qv = Σ over the planes of the faces around
 // v of the squared point–plane distance; p minimizes it. Collapses run cheapest first until
-// the face count reaches `target_face_count`. A collapse is refused when it would
+// the face count reaches `target_face_count`, or, with a distance bound (max_distance > 0),
+// while the result stays within max_distance of the input both ways (the subject's detail
+// sets the face count: simplify_bound_cgal.h). A collapse is refused when it would
 //   - turn the normal of a surviving triangle of the star by more than
 //     max_normal_change_degrees (this also refuses fold-overs),
 //   - create a triangle whose smallest angle is below min_triangle_angle_degrees while
@@ -18,7 +20,8 @@
 // Afterwards a pass of edge flips (optional) lowers Σ (valence − 6)² where a flip keeps the
 // two triangles nearly coplanar and well-shaped; flips keep the face count.
 // The result is checked for self-intersections; if there are some, the collapse is redone
-// from the input with a target larger by `retry_growth`, up to `max_attempts` times.
+// from the input with a target larger (a distance bound smaller) by `retry_growth`, up to
+// `max_attempts` times.
 //
 // Input and output: V #V×3, F #F×3 counter-clockwise seen from outside (see
 // triangle_mesh.h). The output keeps the orientation, the topology (genus and components:
@@ -37,6 +40,18 @@ struct SimplifyOptions {
   // or one face below (a collapse removes two faces); the filters below can stop it early
   // above the target (see SimplifySummary::face_count).
   int target_face_count = 400;
+  // Distance bound, world units; 0 = none (stop at target_face_count). > 0: collapses (and
+  // flips) are done only while every input vertex and face centroid stays within
+  // max_distance of the result and every result vertex and face centroid within
+  // max_distance of the input (simplify_bound_cgal.h), until no collapse keeps that or
+  // min_face_count is reached: thin parts and sharp bends keep their faces, flat and gently
+  // curved regions lose theirs. target_face_count is then not used.
+  double max_distance = 0.0;
+  int min_face_count = 100;
+  // With a distance bound: where more faces remain, collapses go on by cost down to this
+  // many (a cap on memory and time; the bound is then exceeded, SimplifySummary::bound_kept
+  // is false).
+  int max_face_count = 8000;
   // Refuse collapses that rotate a surviving face normal by more than this, degrees.
   double max_normal_change_degrees = 60.0;
   // Refuse collapses that create a triangle with a smaller angle than this, degrees,
@@ -63,13 +78,22 @@ struct SimplifySummary {
   int face_count = 0;
   int vertex_count = 0;
   int attempts = 0;           // collapses run (1 unless self-intersections forced a retry)
+  // With a distance bound: the bound of the last attempt, the faces when it stopped the
+  // collapses (before max_face_count), whether the result keeps it, and the largest
+  // distance of an input sample to the result's face it is attributed to (≥ the sampled
+  // input → result distance).
+  double max_distance = 0.0;
+  int bound_face_count = 0;
+  bool bound_kept = true;
+  double largest_sample_distance = 0.0;
   int flips = 0;              // edges flipped by the valence pass
   std::map<int, int> valence_histogram;  // valence → number of vertices
   double seconds = 0.0;
 };
 
 // Simplifies `mesh` (see the header comment). If the mesh already has at most
-// target_face_count faces it is returned unchanged (after validation).
+// target_face_count faces (with a distance bound: min_face_count) it is returned unchanged
+// (after validation).
 // Throws subflow::Error naming `source` when the mesh is not an oriented 2-manifold, has
 // non-finite vertices or no faces, when the options are out of range (e.g. a target below
 // 4), or when no attempt gives a mesh free of self-intersections.

@@ -2,11 +2,11 @@
 // filters, a valence-improving flip pass and a self-intersection guard.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <vector>
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
-#include <CGAL/Surface_mesh.h>
+#include <CGAL/Surface_mesh_simplification/Edge_collapse_visitor_base.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/GarlandHeckbert_plane_policies.h>
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 #include <CGAL/boost/graph/Euler_operations.h>
@@ -14,18 +14,21 @@
 
 #include "core/error.h"
 #include "core/stopwatch.h"
+#include "geometry/closest_point.h"
 #include "geometry/mesh_topology.h"
 #include "geometry/simplify.h"
+#include "geometry/simplify_bound_cgal.h"
 
 namespace subflow::geometry {
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
+using simplify_internal::DistanceBound;
+using simplify_internal::HalfedgeIndex;
+using simplify_internal::Kernel;
+using simplify_internal::Point;
+using simplify_internal::SurfaceMesh;
+using simplify_internal::VertexIndex;
 using Vector = Kernel::Vector_3;
-using SurfaceMesh = CGAL::Surface_mesh<Point>;
-using VertexIndex = SurfaceMesh::Vertex_index;
-using HalfedgeIndex = SurfaceMesh::Halfedge_index;
 namespace SMS = CGAL::Surface_mesh_simplification;
 namespace PMP = CGAL::Polygon_mesh_processing;
 using GarlandHeckbert = SMS::GarlandHeckbert_plane_policies<SurfaceMesh, Kernel>;
@@ -56,11 +59,13 @@ struct FaceCountStop {
   }
 };
 
-// Refuses collapses that bend, degrade or over-connect the mesh (see simplify.h).
+// Refuses collapses that bend, degrade or over-connect the mesh (see simplify.h), and, with
+// a distance bound, those that break it.
 class ShapeAndValenceFilter {
  public:
-  explicit ShapeAndValenceFilter(const SimplifyOptions& options)
-      : max_normal_change_(options.max_normal_change_degrees * kDegree),
+  ShapeAndValenceFilter(const SimplifyOptions& options, const DistanceBound* bound)
+      : bound_(bound),
+        max_normal_change_(options.max_normal_change_degrees * kDegree),
         min_angle_(options.min_triangle_angle_degrees * kDegree),
         max_valence_(options.max_valence),
         min_valence_(options.min_valence) {}
@@ -92,13 +97,40 @@ class ShapeAndValenceFilter {
       const double new_angle = SmallestAngle(a, p, c);
       if (new_angle < min_angle_ && new_angle < SmallestAngle(a, b, c)) return boost::none;
     }
+    if (bound_ != nullptr && !bound_->AllowsCollapse(profile.v0(), profile.v1(), p)) return boost::none;
     return placement;
   }
 
  private:
+  const DistanceBound* bound_;
   double max_normal_change_, min_angle_;
   int max_valence_, min_valence_;
 };
+
+// Hands the samples of a collapsing star to the new star (DistanceBound).
+struct BoundVisitor : SMS::Edge_collapse_visitor_base<SurfaceMesh> {
+  DistanceBound* bound;
+  explicit BoundVisitor(DistanceBound* b) : bound(b) {}
+  template <typename Profile, typename Placement>
+  void OnCollapsing(const Profile& profile, const Placement&) {
+    if (bound != nullptr) bound->BeforeCollapse(profile.v0(), profile.v1());
+  }
+  template <typename Profile>
+  void OnCollapsed(const Profile&, VertexIndex kept) {
+    if (bound != nullptr) bound->AfterCollapse(kept);
+  }
+};
+
+// Garland–Heckbert collapses, cheapest first, down to `target` faces (or until no collapse
+// passes the filters and the bound).
+void Collapse(std::size_t target, const SimplifyOptions& options, DistanceBound* bound, SurfaceMesh* mesh) {
+  GarlandHeckbert garland_heckbert(*mesh);
+  SMS::edge_collapse(*mesh, FaceCountStop{mesh, target},
+                     CGAL::parameters::get_cost(garland_heckbert.get_cost())
+                         .get_placement(garland_heckbert.get_placement())
+                         .filter(ShapeAndValenceFilter(options, bound))
+                         .visitor(BoundVisitor(bound)));
+}
 
 SurfaceMesh ToSurfaceMesh(const TriangleMesh& mesh) {
   SurfaceMesh result;
@@ -136,8 +168,9 @@ TriangleMesh FromSurfaceMesh(SurfaceMesh mesh) {
   return result;
 }
 
-// One greedy sweep of valence-improving flips; returns the number of flips done.
-int FlipTowardsRegularValence(const SimplifyOptions& options, SurfaceMesh* mesh) {
+// One greedy sweep of valence-improving flips (with a bound: those that keep it); returns
+// the number of flips done.
+int FlipTowardsRegularValence(const SimplifyOptions& options, DistanceBound* bound, SurfaceMesh* mesh) {
   const double max_dihedral = options.max_flip_dihedral_degrees * kDegree;
   const double min_angle = options.min_triangle_angle_degrees * kDegree;
   int flips = 0;
@@ -169,7 +202,12 @@ int FlipTowardsRegularValence(const SimplifyOptions& options, SurfaceMesh* mesh)
     const double old_angle = std::min(SmallestAngle(pa, pb, pc), SmallestAngle(pb, pa, pd));
     const double new_angle = std::min(SmallestAngle(pa, pd, pc), SmallestAngle(pd, pb, pc));
     if (new_angle < min_angle && new_angle < old_angle) continue;
-    CGAL::Euler::flip_edge(h, *mesh);
+    if (bound != nullptr) {
+      if (!bound->AllowsFlip(h)) continue;
+      bound->Flip(h);
+    } else {
+      CGAL::Euler::flip_edge(h, *mesh);
+    }
     ++flips;
   }
   return flips;
@@ -187,9 +225,11 @@ TriangleMesh SimplifyMesh(const TriangleMesh& mesh, const SimplifyOptions& optio
 
   SimplifySummary stats;
   stats.input_face_count = mesh.face_count();
-  if (mesh.face_count() <= options.target_face_count) {
+  const bool bounded = options.max_distance > 0.0;
+  if (mesh.face_count() <= (bounded ? options.min_face_count : options.target_face_count)) {
     stats.face_count = stats.input_face_count;
     stats.vertex_count = mesh.vertex_count();
+    stats.max_distance = options.max_distance;
     for (int v = 0; v < mesh.vertex_count(); ++v) ++stats.valence_histogram[topology.Valence(v)];
     stats.seconds = start.Seconds();
     if (summary != nullptr) *summary = stats;
@@ -197,32 +237,44 @@ TriangleMesh SimplifyMesh(const TriangleMesh& mesh, const SimplifyOptions& optio
   }
   const SurfaceMesh input = ToSurfaceMesh(mesh);
   SurfaceMesh result;
-  double target = options.target_face_count;
+  std::unique_ptr<DistanceBound> bound;
+  double target = options.target_face_count, distance = options.max_distance;
   for (;;) {
     ++stats.attempts;
+    bound.reset();
     result = input;
-    GarlandHeckbert garland_heckbert(result);
-    const FaceCountStop stop{&result, static_cast<std::size_t>(std::lround(target))};
-    SMS::edge_collapse(result, stop,
-                       CGAL::parameters::get_cost(garland_heckbert.get_cost())
-                           .get_placement(garland_heckbert.get_placement())
-                           .filter(ShapeAndValenceFilter(options)));
+    if (bounded) {
+      bound = std::make_unique<DistanceBound>(mesh, &result, distance);
+      Collapse(options.min_face_count, options, bound.get(), &result);
+      stats.max_distance = distance;
+      stats.bound_face_count = static_cast<int>(result.number_of_faces());
+      stats.bound_kept = stats.bound_face_count <= options.max_face_count;
+      if (!stats.bound_kept) Collapse(options.max_face_count, options, nullptr, &result);
+    } else {
+      Collapse(static_cast<std::size_t>(std::lround(target)), options, nullptr, &result);
+    }
     result.collect_garbage();
     stats.flips = 0;
     for (int round = 0; round < options.flip_rounds; ++round) {
-      const int flips = FlipTowardsRegularValence(options, &result);
+      const int flips = FlipTowardsRegularValence(options, stats.bound_kept ? bound.get() : nullptr, &result);
       stats.flips += flips;
       if (flips == 0) break;
     }
     if (!options.check_self_intersections || !PMP::does_self_intersect(result)) break;
     if (stats.attempts >= options.max_attempts)
       ThrowError(source, "simplification",
-                 "every attempt (" + std::to_string(stats.attempts) + ", last target " +
-                     std::to_string(std::lround(target)) +
-                     " faces) gave a self-intersecting mesh; raise target_face_count");
+                 "every attempt (" + std::to_string(stats.attempts) + ", last " +
+                     (bounded ? "distance bound " + std::to_string(distance)
+                              : "target " + std::to_string(std::lround(target)) + " faces") +
+                     ") gave a self-intersecting mesh; raise target_face_count or lower max_distance");
     target *= options.retry_growth;
+    distance /= options.retry_growth;
   }
   TriangleMesh simplified = FromSurfaceMesh(std::move(result));
+  if (bound)
+    stats.largest_sample_distance =
+        bound->LargestSampleDistance(ClosestPointTree(simplified, source + " (simplified)"));
+  bound.reset();
   const MeshTopology simplified_topology(simplified.F, simplified.vertex_count(),
                                          source + " (simplified)");
   for (int v = 0; v < simplified.vertex_count(); ++v)
@@ -253,6 +305,10 @@ void SimplifyOptions::Check() const {
   if (!(max_flip_dihedral_degrees > 0.0 && max_flip_dihedral_degrees < 180.0))
     fail("max_flip_dihedral_degrees", "expected an angle in (0, 180) degrees");
   if (max_attempts < 1) fail("max_attempts", "expected ≥ 1");
+  if (!(max_distance >= 0.0 && std::isfinite(max_distance)))
+    fail("max_distance", "expected 0 (no bound) or a finite distance > 0");
+  if (min_face_count < 4) fail("min_face_count", "expected at least 4 faces (a tetrahedron)");
+  if (max_face_count < min_face_count) fail("max_face_count", "expected ≥ min_face_count");
   if (!(retry_growth > 1.0 && std::isfinite(retry_growth)))
     fail("retry_growth", "expected a finite factor > 1");
 }

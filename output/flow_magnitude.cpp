@@ -32,6 +32,17 @@ void ForEachFrameFlow(const ResultReader& result, const std::vector<FlowKind>& k
   }
 }
 
+void ForEachFrameProperty(const ResultReader& result, const std::string& name,
+                          const std::function<void(const ResultFrame&, const Eigen::VectorXf&)>& visit) {
+  for (int i = 0; i < result.frame_count(); ++i) {
+    const ResultFrame frame = result.ReadFrame(i);
+    const auto found = frame.properties.values.find(name);
+    if (found == frame.properties.values.end())
+      ThrowError(result.MeshPath(i), "vertex property " + name, "missing (asked for by --colour-by)");
+    visit(frame, found->second.cast<float>());
+  }
+}
+
 bool HasFlow(const ResultReader& result, FlowKind kind) {
   const ResultFrame first = result.ReadFrame(0);
   return first.properties.values.count(FlowPropertyPrefix(kind) + "x") > 0;

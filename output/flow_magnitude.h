@@ -33,6 +33,12 @@ FlowKind ParseFlowKind(const std::string& name, const std::string& source);
 void ForEachFrameFlow(const ResultReader& result, const std::vector<FlowKind>& kinds,
                       const std::function<void(const ResultFrame&, const std::vector<Eigen::VectorXf>&)>& visit);
 
+// Calls visit(frame, values) for every frame of `result` in order with the #V values of
+// its scalar vertex property `name` (e.g. motion_energy, or the error of `subflow eval
+// --error-maps`); throws subflow::Error naming the file when a frame lacks it.
+void ForEachFrameProperty(const ResultReader& result, const std::string& name,
+                          const std::function<void(const ResultFrame&, const Eigen::VectorXf&)>& visit);
+
 // Whether the result's frames carry the properties of `kind` (looked up in the first frame).
 bool HasFlow(const ResultReader& result, FlowKind kind);
 

@@ -23,6 +23,8 @@
 #include "solver/shape/shape_init.h"
 #include "solver/stereo/stereo_refinement.h"
 #include "vision/silhouettes.h"
+#include "vision/standing_evidence.h"
+#include "vision/still_evidence.h"
 #include "vision/voxel_carving.h"
 
 namespace subflow::output {
@@ -76,6 +78,17 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SilhouetteOptions, source, background_blur_si
                                    motion_threshold, motion_method, motion_min_threshold, estimate_background,
                                    background_estimate_min_frames, background_estimate_margin, close_radius,
                                    fill_holes, min_region_pixels, min_object_pixels)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StandingEvidenceOptions, enabled, noise_factor, min_threshold)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(PlaneSweepOptions, neighbours, max_neighbour_degrees, consistent_views,
+                                   window_radius, max_step_pixels, max_planes, sweep_beyond_volume, min_score,
+                                   min_texture, uniqueness_margin, uniqueness_planes, threads)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DepthFusionOptions, consistent_cameras, consistency_planes,
+                                   unconfirmed_min_score, free_space_planes, free_votes, min_hits, min_cameras,
+                                   min_component_fraction)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SupportPlaneOptions, tolerance, iterations, sample_points, min_inlier_fraction,
+                                   min_above_fraction, seed)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StillEvidenceOptions, enabled, sweep, fusion, remove_support_plane,
+                                   support_plane, support_tolerance_planes)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VoxelCarvingOptions, resolution, pixels_per_voxel, max_auto_resolution,
                                    max_pixels_per_voxel,
                                    min_cameras, max_misses, evidence_threshold, footprint_margin, closing_radius,
@@ -89,7 +102,8 @@ namespace subflow::geometry {
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(IsosurfaceOptions, iso_value, smoothing_sigma_voxels, padding_voxels,
                                    facet_angle_degrees, facet_size_voxels, facet_distance_voxels,
                                    max_vertex_count, random_seed)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_normal_change_degrees,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_distance, min_face_count,
+                                   max_face_count, max_normal_change_degrees,
                                    min_triangle_angle_degrees, max_valence, min_valence, flip_rounds,
                                    max_flip_dihedral_degrees, check_self_intersections, max_attempts, retry_growth)
 
@@ -98,7 +112,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_norma
 namespace subflow::solver {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, carving, isosurface, simplify, fit, levels,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, standing, still, carving, isosurface, simplify, fit,
+                                   base_distance_voxels, levels, finest_edge_pixels, max_finest_faces,
                                    reference_frame, first_frame, frame_count, image_edge_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,
@@ -111,6 +126,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solv
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(WindowSolverOptions, linear_solver, max_iterations, threads, function_tolerance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
+                                   per_patch_levels,
                                    normal_only_from_level, window, window_overlap, rounds, solver,
                                    samples_per_pixel, min_density, max_density, max_cameras, min_samples,
                                    image_sigma, ncc_epsilon, ncc_loss_scale, temporal_weight, silhouette_weight,

@@ -97,7 +97,7 @@ class PlanBuilder {
 
 nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dataset& dataset,
                          const solver::ReconstructionOptions& options, const PlanOptions& plan_options,
-                         const std::string& directory_name) {
+                         const std::string& directory_name, const nlohmann::json& arguments) {
   options.Check();
   plan_options.Check();
   const std::string directory = fs::absolute(directory_name).lexically_normal().string();
@@ -142,6 +142,7 @@ nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dat
            {plan.Folder(last)}, plan.Folder("result"), {last});
 
   nlohmann::json json = {{"plan_version", kPlanVersion},
+                         {"arguments", arguments},
                          {"dataset", dataset_path},
                          {"directory", directory},
                          {"frames", {take.first, take.end}},

@@ -48,10 +48,10 @@ inline constexpr int kDefaultTaskMemoryMiB = 4096;
 // Builds the plan of `options` on `dataset` for the directory `directory` (absolute paths
 // in the task arguments) and writes directory/plan.json and directory/options.json (the
 // options every task reads: --options); with options.slurm, also directory/slurm/.
-// Returns the plan.
+// `arguments`: the command line of `subflow plan`, recorded in plan.json. Returns the plan.
 nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dataset& dataset,
                          const solver::ReconstructionOptions& options, const PlanOptions& plan_options,
-                         const std::string& directory);
+                         const std::string& directory, const nlohmann::json& arguments = nlohmann::json::object());
 
 // Reads directory/plan.json; throws subflow::Error naming it.
 nlohmann::json ReadPlan(const std::string& directory);

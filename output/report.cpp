@@ -49,6 +49,7 @@ nlohmann::json DatasetJson(const vision::Dataset& dataset) {
 
 nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset) {
   return {{"command", run.command},
+          {"arguments", run.arguments},
           {"output", run.out},
           {"overwrite", run.overwrite},
           {"resume", run.resume},
@@ -82,6 +83,31 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
                                     {"frames", background.frames},
                                     {"known_fraction", background.known_fraction},
                                     {"mean_free_frames", background.mean_free_frames}});
+  }
+
+  // What stands still, added to the silhouettes from estimated backgrounds (null: none).
+  nlohmann::json standing = nullptr;
+  for (size_t c = 0; c < result.standing.size(); ++c) {
+    if (standing.is_null()) standing = nlohmann::json::array();
+    standing.push_back({{"name", dataset.camera(static_cast<int>(c)).name()},
+                        {"threshold", result.standing[c].threshold},
+                        {"object_pixels", result.standing[c].object_pixels}});
+  }
+  // The still set's photo-consistency, when it was the evidence (null: not used).
+  nlohmann::json still = nullptr;
+  if (result.used_still) {
+    nlohmann::json cameras = nlohmann::json::array();
+    for (const vision::StillCameraReport& camera : result.still.cameras)
+      cameras.push_back({{"name", camera.name}, {"planes", camera.planes}, {"depth_pixels", camera.depth_pixels},
+                         {"trusted_pixels", camera.trusted_pixels}, {"support_pixels", camera.support_pixels},
+                         {"silhouette_pixels", camera.silhouette_pixels}, {"sweep_seconds", camera.sweep_seconds}});
+    const vision::SupportPlane& plane = result.still.support;
+    still = {{"support_plane", {{"found", plane.found}, {"normal", Vector3(plane.normal)}, {"offset", plane.offset},
+                                {"tolerance", plane.tolerance}, {"inliers", plane.inliers}, {"points", plane.points},
+                                {"above_fraction", plane.above_fraction}}},
+             {"occupied_voxels", result.still.fused.occupied_voxels},
+             {"cameras", cameras},
+             {"seconds", result.still.seconds}};
   }
 
   nlohmann::json frames = nlohmann::json::array();
@@ -128,9 +154,18 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
           {"base_mesh", {{"vertices", result.base_mesh.vertex_count()},
                          {"faces", result.base_mesh.face_count()},
                          {"valence_histogram", valences},
-                         {"simplify_attempts", result.simplify.attempts}}},
+                         {"simplify_attempts", result.simplify.attempts},
+                         {"max_distance", result.simplify.max_distance},
+                         {"bound_kept", result.simplify.bound_kept},
+                         {"largest_sample_distance", result.simplify.largest_sample_distance},
+                         {"bound_face_count", result.resolution.bound_face_count},
+                         {"bound_edge_pixels", result.resolution.bound_edge_pixels},
+                         {"edge_pixels", result.resolution.base_edge_pixels},
+                         {"finest_edge_pixels", result.resolution.finest_edge_pixels}}},
           {"levels", levels},
           {"estimated_background", estimated},
+          {"standing", standing},
+          {"still", still},
           {"frames", frames},
           {"seconds", {{"carve", carve}, {"isosurface", isosurface}, {"simplify", result.simplify_seconds},
                        {"fit", fit}}}};

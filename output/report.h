@@ -27,9 +27,11 @@ struct CommandRun {
   std::string out;
   bool overwrite = false;
   bool resume = false;  // reconstruct --resume
+  nlohmann::json arguments = nlohmann::json::object();  // the command line (cli::ArgumentsJson)
 };
 
-// {"command", "output", "overwrite", "resume", "versions", "dataset"}: the head of every report.
+// {"command", "arguments", "output", "overwrite", "resume", "versions", "dataset"}: the head
+// of every report.
 nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset);
 
 // Figures of shape initialization: reference frame, base mesh, levels, the backgrounds

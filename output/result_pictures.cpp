@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <set>
 
@@ -215,14 +216,30 @@ RenderSummary RenderResultPictures(const ResultReader& result, const vision::Dat
   RenderSummary summary;
   std::vector<FlowKind> kinds = {FlowKind::kTotal};
   if (HasFlow(result, FlowKind::kNonRigid)) kinds.push_back(FlowKind::kNonRigid);
+  if (!options.colour_by.empty()) kinds.clear();
   std::vector<std::string> kind_names;
   std::vector<ColourScale> scales;
   for (FlowKind kind : kinds) {
     const FlowRange range = SequenceFlowRange(result, kind);
     kind_names.push_back(kind == FlowKind::kTotal ? "flow" : "nonrigid");
     scales.push_back({range.min, range.max, metadata.DisplayFactor(), FlowLabel(kind), metadata.DisplayUnit() + "/frame"});
-    summary.scales[kind_names.back()] = scales.back();
   }
+  if (!options.colour_by.empty()) {
+    FlowRange range{options.colour_range.empty() ? 0.0 : options.colour_range[0],
+                    options.colour_range.empty() ? 0.0 : options.colour_range[1]};
+    if (options.colour_range.empty()) {
+      range = {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+      ForEachFrameProperty(result, options.colour_by, [&](const ResultFrame&, const Eigen::VectorXf& values) {
+        range.min = std::min(range.min, static_cast<double>(values.minCoeff()));
+        range.max = std::max(range.max, static_cast<double>(values.maxCoeff()));
+      });
+    } else if (options.colour_range.size() != 2 || !(options.colour_range[0] < options.colour_range[1])) {
+      ThrowError("--colour-range", "", "expected MIN,MAX with MIN < MAX");
+    }
+    kind_names.push_back(options.colour_by);
+    scales.push_back({range.min, range.max, metadata.DisplayFactor(), options.colour_by, metadata.DisplayUnit()});
+  }
+  for (std::size_t k = 0; k < kind_names.size(); ++k) summary.scales[kind_names[k]] = scales[k];
   const std::vector<int> frames = SelectedFrames(result, options.frames);
   const int turntable_frame = options.turntable_frame >= 0 ? options.turntable_frame
                                                            : result.first_frame() + (result.frame_count() - 1) / 2;
@@ -231,18 +248,23 @@ RenderSummary RenderResultPictures(const ResultReader& result, const vision::Dat
   ResultPainter painter(dataset, kind_names, scales, options, out, metadata.fps, &summary);
 
   ProgressBegin(progress, "pictures", static_cast<std::size_t>(result.frame_count()));
-  ForEachFrameFlow(result, kinds, [&](const ResultFrame& frame, const std::vector<Eigen::VectorXf>& magnitudes) {
+  const auto paint = [&](const ResultFrame& frame, const std::vector<Eigen::VectorXf>& magnitudes) {
     const bool selected = std::find(frames.begin(), frames.end(), frame.frame) != frames.end();
     const bool turntable = frame.frame == turntable_frame && options.turntable.count > 0;
     if (selected || turntable || (options.mp4 && dataset)) {
       FrameScene scene{frame, result.faces(), geometry::VertexNormals(frame.V, result.faces()), {},
                        vision::FrameName(frame.frame), selected};
-      for (std::size_t k = 0; k < kinds.size(); ++k) scene.colours.push_back(VertexColours(magnitudes[k], scales[k]));
+      for (std::size_t k = 0; k < scales.size(); ++k) scene.colours.push_back(VertexColours(magnitudes[k], scales[k]));
       if (dataset) painter.CameraPictures(scene);
       if (turntable) painter.TurntablePictures(scene, up);
     }
     ProgressUpdate(progress, static_cast<std::size_t>(frame.frame - result.first_frame() + 1));
-  });
+  };
+  if (options.colour_by.empty())
+    ForEachFrameFlow(result, kinds, paint);
+  else
+    ForEachFrameProperty(result, options.colour_by,
+                         [&](const ResultFrame& frame, const Eigen::VectorXf& values) { paint(frame, {values}); });
   ProgressEnd(progress);
   painter.Finish(result.first_frame(), &summary);
   return summary;

@@ -10,6 +10,7 @@
 //   overlay/<camera>/<frame>.png       outline + flow shading over the undistorted input
 //   contact_sheet/<frame>.png          the overlays of every camera in one picture
 //   mp4/<camera>.mp4                   overlays of every frame (with mp4 = true)
+// With colour_by = a vertex property, that property replaces the flows in every picture.
 // Colour scales run over the whole sequence's magnitudes (SequenceFlowRange), so
 // pictures of different frames compare. Without a dataset only the turntable is drawn.
 #pragma once
@@ -40,6 +41,12 @@ struct RenderOptions {
   bool mp4 = false;              // an MP4 of the overlays per camera, every frame, at the result's fps
   ShadingOptions shading;
   OverlayOptions overlay;
+  // A scalar vertex property to colour by instead of the flows (e.g. "distance" of
+  // `subflow eval --error-maps`); pictures are then named by it (<colour_by>/<camera>/...).
+  std::string colour_by;
+  // The colour range of colour_by (world units as stored): {min, max}; empty = the
+  // sequence's smallest and largest value.
+  std::vector<double> colour_range;
 };
 
 // One picture written, for report.json and tests.

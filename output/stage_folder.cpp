@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "core/json_reader.h"
 #include "geometry/mesh_io.h"
 #include "output/result_files.h"
@@ -22,7 +23,7 @@ std::string ReportPath(const std::string& folder) { return (fs::path(folder) / "
 
 // A mesh of the folder, without the manifold check (the stage that wrote it had it).
 geometry::TriangleMesh ReadStageMesh(const fs::path& path) {
-  if (!fs::exists(path)) ThrowError(path.string(), "", "missing (expected a file of the stage folder)");
+  if (!EntryExists(path)) ThrowError(path.string(), "", "missing (expected a file of the stage folder)");
   geometry::MeshReadOptions options;
   options.require_manifold = false;
   return geometry::ReadMesh(path.string(), options);
@@ -63,12 +64,12 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
   WriteJsonFile(ReportPath(folder), report);
 }
 
-bool StageFolderComplete(const std::string& folder) { return fs::is_regular_file(ReportPath(folder)); }
+bool StageFolderComplete(const std::string& folder) { return IsFile(ReportPath(folder)); }
 
 StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage, int first_wanted,
                             int count_wanted) {
   const std::string report_path = ReportPath(folder);
-  if (!fs::is_directory(folder)) ThrowError(folder, "", "not a directory (expected a stage folder)");
+  if (!IsDirectory(folder)) ThrowError(folder, "", "not a directory (expected a stage folder)");
   if (!StageFolderComplete(folder))
     ThrowError(report_path, "", "missing: the stage that wrote this folder did not finish");
   StageRecord record;

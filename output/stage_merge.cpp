@@ -107,6 +107,7 @@ nlohmann::json MergeStageFolders(const CommandRun& run, const std::vector<std::s
 
   nlohmann::json report = parts.front().report;
   report["command"] = run.command;
+  report["arguments"] = run.arguments;
   report["output"] = run.out;
   report["overwrite"] = run.overwrite;
   report["frames"] = {{"first", first}, {"count", end - first}};

@@ -99,6 +99,32 @@ Bounds DeriveBounds(const std::vector<Camera>& cameras, const DatasetImportOptio
   return box;
 }
 
+// The frame count every camera has (or --frames) and the common frame rate of videos, in
+// `result`, with a note when the cameras differ in length.
+void CountFrames(const std::vector<CameraMedia>& media, const DatasetImportOptions& options,
+                 DatasetImportResult* result) {
+  int available = media.front().frame_count, most = available;
+  for (const CameraMedia& m : media) {
+    if (m.frame_count <= 0)
+      ThrowError(m.files.front(), "frame count", "unknown (the container does not report it)");
+    available = std::min(available, m.frame_count);
+    most = std::max(most, m.frame_count);
+  }
+  if (most != available)
+    result->notes.push_back("cameras have " + std::to_string(available) + " to " + std::to_string(most) +
+                            " frames; the first " + std::to_string(available) + " are used");
+  if (options.frames && *options.frames > available)
+    ThrowError("--frames", "", "expected at most the " + std::to_string(available) + " frames every camera has, got " +
+                                   std::to_string(*options.frames));
+  result->frame_count = options.frames ? *options.frames : available;
+  if (media.front().video) {
+    const double fps = media.front().fps;
+    bool same = fps > 0;
+    for (const CameraMedia& m : media) same = same && std::abs(m.fps - fps) <= 1e-3 * fps;
+    if (same) result->fps = fps;
+  }
+}
+
 }  // namespace
 
 void DatasetImportOptions::Check() const {
@@ -167,29 +193,7 @@ DatasetImportResult ImportDataset(const Calibration& source_calibration, const s
   ProgressEnd(progress);
   const std::vector<Camera> cameras = ToCameras(calibration, metres_per_unit);
 
-  // Frames and frame rate.
-  if (has_media) {
-    int available = media.front().frame_count, most = available;
-    for (const CameraMedia& m : media) {
-      if (m.frame_count <= 0)
-        ThrowError(m.files.front(), "frame count", "unknown (the container does not report it)");
-      available = std::min(available, m.frame_count);
-      most = std::max(most, m.frame_count);
-    }
-    if (most != available)
-      result.notes.push_back("cameras have " + std::to_string(available) + " to " + std::to_string(most) +
-                             " frames; the first " + std::to_string(available) + " are used");
-    if (options.frames && *options.frames > available)
-      ThrowError("--frames", "", "expected at most the " + std::to_string(available) + " frames every camera has, got " +
-                                     std::to_string(*options.frames));
-    result.frame_count = options.frames ? *options.frames : available;
-    if (media.front().video) {
-      const double fps = media.front().fps;
-      bool same = fps > 0;
-      for (const CameraMedia& m : media) same = same && std::abs(m.fps - fps) <= 1e-3 * fps;
-      if (same) result.fps = fps;
-    }
-  }
+  if (has_media) CountFrames(media, options, &result);
 
   // Working volume.
   if (options.bounds) {

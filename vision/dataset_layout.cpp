@@ -12,6 +12,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "vision/import_media.h"
 
 namespace subflow::vision {
@@ -75,7 +76,7 @@ std::vector<std::set<int>> ScanFrameFolders(const fs::path& root, const std::vec
   for (const Camera& camera : cameras) names.insert(camera.name());
   for (const auto& entry : fs::directory_iterator(root)) {
     if (Hidden(entry.path())) continue;
-    if (!entry.is_directory() || !names.count(entry.path().filename().string()))
+    if (!IsDirectory(entry.path()) || !names.count(entry.path().filename().string()))
       ThrowError(Str(entry.path()), "",
                  "unknown camera folder (expected one folder per camera of cameras.json: " +
                      CameraList(cameras) + ")");
@@ -83,7 +84,7 @@ std::vector<std::set<int>> ScanFrameFolders(const fs::path& root, const std::vec
   std::vector<std::set<int>> frames(cameras.size());
   for (std::size_t c = 0; c < cameras.size(); ++c) {
     const fs::path folder = root / cameras[c].name();
-    if (!fs::is_directory(folder))
+    if (!IsDirectory(folder))
       ThrowError(Str(folder), "", "missing: camera \"" + cameras[c].name() +
                                       "\" has no folder (expected " + Str(folder) + "/000000" +
                                       extension + ", ...)");
@@ -101,7 +102,7 @@ std::vector<std::set<int>> ScanFrameFolders(const fs::path& root, const std::vec
     for (const auto& entry : fs::directory_iterator(folder)) {
       if (Hidden(entry.path())) continue;
       const int frame = FrameIndex(entry.path().filename().string(), extension);
-      if (frame < 0 || !entry.is_regular_file())
+      if (frame < 0 || !IsFile(entry.path()))
         ThrowError(Str(entry.path()), "",
                    "unexpected file (expected frames named <6-digit frame>" + extension + ", e.g. 000000" +
                        extension + ")");
@@ -166,7 +167,7 @@ void CheckImageSize(const cv::Mat& image, const Camera& camera, const std::strin
 }
 
 cv::Mat ReadImageFile(const std::string& path, const Camera& camera) {
-  if (!fs::is_regular_file(path)) ThrowError(path, "", "missing image file");
+  if (!IsFile(path)) ThrowError(path, "", "missing image file");
   cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty())
     ThrowError(path, "", "unreadable image (cv::imread failed; expected an 8- or 16-bit PNG or another image file)");
@@ -192,7 +193,7 @@ void ScanVideos(const fs::path& videos, DatasetLayout* out) {
     const std::string stem = entry.path().stem().string();
     auto it = std::find_if(cameras.begin(), cameras.end(),
                            [&](const Camera& camera) { return camera.name() == stem; });
-    if (it == cameras.end() || !entry.is_regular_file())
+    if (it == cameras.end() || !IsFile(entry.path()))
       ThrowError(Str(entry.path()), "", "unknown camera video (expected videos/<camera>.<ext> for the "
                                         "cameras of cameras.json: " + CameraList(cameras) + ")");
     std::string& path = layout.video_paths[it - cameras.begin()];
@@ -250,7 +251,7 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
   DatasetLayout layout;
   layout.directory = directory;
   const fs::path root(directory);
-  if (!fs::is_directory(root))
+  if (!IsDirectory(root))
     ThrowError(directory, "", "not a directory (expected a dataset directory with cameras.json)");
   layout.cameras_path = Str(root / "cameras.json");
   layout.cameras = ReadCamerasJson(layout.cameras_path, &layout.info);
@@ -259,9 +260,9 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
       layout.info.frame_count ? "frame_count in cameras.json" : "frame count found on disk";
 
   const fs::path images = root / "images", videos = root / "videos";
-  if (fs::exists(images) && fs::exists(videos))
+  if (EntryExists(images) && EntryExists(videos))
     ThrowError(directory, "images/ and videos/", "both present; expected exactly one source of frames");
-  if (fs::is_directory(images)) {
+  if (IsDirectory(images)) {
     const std::vector<std::set<int>> frames = ScanFrameFolders(images, cameras, ".png", &layout.image_extensions);
     if (layout.info.frame_count) {
       layout.frame_count = *layout.info.frame_count;
@@ -270,15 +271,15 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
     }
     for (std::size_t c = 0; c < cameras.size(); ++c)
       CheckFrames({frames[c]}, layout.frame_count, images, {cameras[c]}, layout.image_extensions[c], count_origin);
-  } else if (fs::is_directory(videos)) {
+  } else if (IsDirectory(videos)) {
     ScanVideos(videos, &layout);
   } else {
     ThrowError(directory, "images/", "missing (expected images/<camera>/<frame>.png or videos/<camera>.<ext>)");
   }
 
   const fs::path masks = root / "masks";
-  if (fs::exists(masks)) {
-    if (!fs::is_directory(masks)) ThrowError(Str(masks), "", "expected a folder of per-camera mask folders");
+  if (EntryExists(masks)) {
+    if (!IsDirectory(masks)) ThrowError(Str(masks), "", "expected a folder of per-camera mask folders");
     layout.masks = true;
     const std::vector<std::set<int>> frames = ScanFrameFolders(masks, cameras, ".png");
     CheckFrames(frames, layout.frame_count, masks, cameras, ".png",
@@ -286,7 +287,7 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
   }
 
   const fs::path background = root / "background";
-  if (fs::exists(background)) {
+  if (EntryExists(background)) {
     layout.background = true;
     std::set<std::string> names;
     for (const Camera& camera : cameras) names.insert(camera.name() + ".png");
@@ -297,15 +298,15 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
                                           "for the cameras of cameras.json: " + CameraList(cameras) + ")");
     }
     for (int c = 0; c < static_cast<int>(cameras.size()); ++c)
-      if (!fs::is_regular_file(layout.BackgroundPath(c)))
+      if (!IsFile(layout.BackgroundPath(c)))
         ThrowError(layout.BackgroundPath(c), "", "missing background image of camera \"" + cameras[c].name() +
                                                      "\" (background/ must have one per camera)");
   }
 
   const fs::path groundtruth = root / "groundtruth";
-  if (fs::exists(groundtruth)) {
+  if (EntryExists(groundtruth)) {
     const fs::path mesh = groundtruth / "mesh";
-    if (!fs::is_directory(mesh))
+    if (!IsDirectory(mesh))
       ThrowError(Str(mesh), "", "missing (expected groundtruth/mesh/<frame>.ply)");
     layout.groundtruth = true;
     for (const auto& entry : fs::directory_iterator(mesh)) {
@@ -316,7 +317,7 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
                                               FrameName(layout.frame_count - 1) + ")");
     }
     for (int f = 0; f < layout.frame_count; ++f)
-      if (!fs::is_regular_file(layout.GroundTruthMeshPath(f)))
+      if (!IsFile(layout.GroundTruthMeshPath(f)))
         ThrowError(layout.GroundTruthMeshPath(f), "", "missing ground-truth mesh of frame " + std::to_string(f));
   }
 

@@ -120,6 +120,10 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
                    std::to_string(frame));
   if (options.source == EvidenceSource::kMask && !dataset.has_masks())
     ThrowError(source_name, "masks/", "evidence source \"mask\" asked for, but the dataset has no masks");
+  if (options.source == EvidenceSource::kStill)
+    ThrowError(source_name, "evidence source",
+               "\"still\" is photo-consistency over every camera's image, computed by shape initialization "
+               "(vision/still_evidence.h), not per camera");
   if (options.source == EvidenceSource::kMotion && dataset.frame_count() < 2)
     ThrowError(source_name, "frame_count",
                "evidence source \"motion\" needs at least 2 frames, the dataset has 1");

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "geometry/mesh_io.h"
 #include "vision/dataset.h"
 #include "vision/evaluation.h"
@@ -129,7 +130,7 @@ EvaluationReport EvaluateReconstruction(const std::string& dataset_directory,
   const std::string result_meshes = (fs::path(result_directory) / surfaces).string();
   // Without cameras.json (a folder of ground truth only) there is no observed surface.
   const fs::path cameras_path = fs::path(dataset_directory) / "cameras.json";
-  const std::vector<Camera> cameras = fs::exists(cameras_path) ? ReadCamerasJson(cameras_path.string())
+  const std::vector<Camera> cameras = EntryExists(cameras_path) ? ReadCamerasJson(cameras_path.string())
                                                                : std::vector<Camera>();
   // A result may cover a contiguous part of the sequence (reconstruct --first-frame/--frames).
   int first = 0;

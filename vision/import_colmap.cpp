@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "core/error.h"
+#include "core/file_status.h"
 
 namespace subflow::vision {
 namespace fs = std::filesystem;
@@ -275,8 +276,8 @@ Calibration ParseColmapBinaryModel(const std::string& cameras_bin, const std::st
 
 Calibration ReadColmapModel(const std::string& directory, const ColmapImportOptions& options) {
   const fs::path root(directory);
-  if (!fs::is_directory(root)) ThrowError(directory, "", "not a directory (expected a COLMAP sparse model folder)");
-  if (fs::exists(root / "cameras.bin") && fs::exists(root / "images.bin"))
+  if (!IsDirectory(root)) ThrowError(directory, "", "not a directory (expected a COLMAP sparse model folder)");
+  if (EntryExists(root / "cameras.bin") || EntryExists(root / "images.bin"))  // a broken .bin is reported
     return ParseColmapBinaryModel(ReadCalibrationFile((root / "cameras.bin").string(), "COLMAP's cameras.bin"),
                                   ReadCalibrationFile((root / "images.bin").string(), "COLMAP's images.bin"),
                                   directory, options);

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "vision/import_toml.h"
 
 namespace subflow::vision {
@@ -19,27 +20,55 @@ cv::FileStorage Open(const std::string& text, const std::string& source) {
     return storage;
   } catch (const cv::Exception& e) {
     ThrowError(source, "", "cannot parse (expected OpenCV FileStorage YAML): " + e.msg);
+  } catch (const std::exception& e) {  // the parser also lets std::length_error and the like out
+    ThrowError(source, "", std::string("cannot parse (expected OpenCV FileStorage YAML): ") + e.what());
   }
+}
+
+// storage[key]; OpenCV throws when the document's top level is not a map.
+cv::FileNode Node(const cv::FileStorage& storage, const std::string& key, const std::string& source) {
+  try {
+    return storage[key];
+  } catch (const cv::Exception& e) {
+    ThrowError(source, key, "cannot look up (expected a YAML map at the top level): " + e.msg);
+  }
+}
+
+// The matrix stored at `node` (an !!opencv-matrix), as doubles. Its rows and cols are
+// checked against its data before OpenCV allocates them (a calibration matrix is small).
+cv::Mat ReadMat(const cv::FileNode& node, const std::string& key, const std::string& source) {
+  constexpr int kMaxSide = 64;
+  cv::Mat mat;
+  try {
+    if (!node.isMap()) ThrowError(source, key, "expected an !!opencv-matrix (rows, cols, dt, data)");
+    const cv::FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
+    if (!rows.isInt() || !cols.isInt() || !data.isSeq())
+      ThrowError(source, key, "expected an !!opencv-matrix with integer rows and cols and a data list");
+    const int r = static_cast<int>(rows), c = static_cast<int>(cols);
+    if (r < 1 || c < 1 || r > kMaxSide || c > kMaxSide || static_cast<std::size_t>(r) * c != data.size())
+      ThrowError(source, key, "expected rows and cols in 1.." + std::to_string(kMaxSide) +
+                                  " with rows × cols values in data, got " + std::to_string(r) + "×" +
+                                  std::to_string(c) + " and " + std::to_string(data.size()) + " values");
+    node >> mat;
+    mat.convertTo(mat, CV_64F);
+  } catch (const cv::Exception& e) {
+    ThrowError(source, key, "expected an !!opencv-matrix: " + e.msg);
+  }
+  return mat;
 }
 
 // The matrix at `key` with `rows`×`cols` (or the transposed shape) doubles.
 Eigen::MatrixXd Matrix(const cv::FileStorage& storage, const std::string& key, int rows, int cols,
                        const std::string& source, bool required = true) {
-  const cv::FileNode node = storage[key];
+  const cv::FileNode node = Node(storage, key, source);
   if (node.empty()) {
     if (required) ThrowError(source, key, "missing (expected a " + std::to_string(rows) + "×" + std::to_string(cols) + " !!opencv-matrix)");
     return Eigen::MatrixXd();
   }
-  cv::Mat mat;
-  try {
-    node >> mat;
-  } catch (const cv::Exception& e) {
-    ThrowError(source, key, "expected an !!opencv-matrix: " + e.msg);
-  }
+  const cv::Mat mat = ReadMat(node, key, source);
   if (mat.empty() || mat.channels() != 1 || !((mat.rows == rows && mat.cols == cols) || (mat.rows == cols && mat.cols == rows)))
     ThrowError(source, key, "expected a " + std::to_string(rows) + "×" + std::to_string(cols) + " matrix, got " +
                                 std::to_string(mat.rows) + "×" + std::to_string(mat.cols));
-  mat.convertTo(mat, CV_64F);
   Eigen::MatrixXd out(mat.rows, mat.cols);
   for (int r = 0; r < mat.rows; ++r)
     for (int c = 0; c < mat.cols; ++c) {
@@ -50,7 +79,7 @@ Eigen::MatrixXd Matrix(const cv::FileStorage& storage, const std::string& key, i
 }
 
 std::vector<std::string> Names(const cv::FileStorage& storage, const std::string& source) {
-  const cv::FileNode node = storage["names"];
+  const cv::FileNode node = Node(storage, "names", source);
   if (!node.isSeq() || node.size() == 0) ThrowError(source, "names", "missing (expected a list of camera names)");
   std::vector<std::string> names;
   for (const cv::FileNode& item : node) {
@@ -62,7 +91,7 @@ std::vector<std::string> Names(const cv::FileStorage& storage, const std::string
 }
 
 int OptionalInt(const cv::FileStorage& storage, const std::string& key, const std::string& source) {
-  const cv::FileNode node = storage[key];
+  const cv::FileNode node = Node(storage, key, source);
   if (node.empty()) return 0;
   if (!node.isInt() && !node.isReal()) ThrowError(source, key, "expected an integer");
   const double value = node.real();
@@ -86,12 +115,11 @@ Calibration ParseEasyMocapCalibration(const std::string& intri_yml, const std::s
     camera.K = Matrix(intri, "K_" + name, 3, 3, intri_source);
     Eigen::MatrixXd d = Matrix(intri, "dist_" + name, 1, 5, intri_source, false);
     if (d.size() == 0) {
-      const cv::FileNode node = intri["dist_" + name].empty() ? intri["D_" + name] : intri["dist_" + name];
-      cv::Mat mat;
-      if (!node.empty()) node >> mat;
+      const std::string key = Node(intri, "dist_" + name, intri_source).empty() ? "D_" + name : "dist_" + name;
+      const cv::FileNode node = Node(intri, key, intri_source);
+      const cv::Mat mat = node.empty() ? cv::Mat() : ReadMat(node, key, intri_source);
       if (mat.total() != 4 && mat.total() != 5 && mat.total() != 8)
-        ThrowError(intri_source, "dist_" + name, "missing or not 4, 5 or 8 values (k1 k2 p1 p2 [k3 [k4 k5 k6]])");
-      mat.convertTo(mat, CV_64F);
+        ThrowError(intri_source, key, "missing or not 4, 5 or 8 values (k1 k2 p1 p2 [k3 [k4 k5 k6]])");
       d.resize(1, mat.total());
       for (int i = 0; i < static_cast<int>(mat.total()); ++i) d(0, i) = mat.at<double>(i);
     }
@@ -111,7 +139,7 @@ Calibration ParseEasyMocapCalibration(const std::string& intri_yml, const std::s
 }
 
 Calibration ReadEasyMocapCalibration(const std::string& path) {
-  const fs::path folder = fs::is_directory(path) ? fs::path(path) : fs::path(path).parent_path();
+  const fs::path folder = IsDirectory(path) ? fs::path(path) : fs::path(path).parent_path();
   const std::string intri = (folder / "intri.yml").string(), extri = (folder / "extri.yml").string();
   return ParseEasyMocapCalibration(ReadCalibrationFile(intri, "EasyMocap's intri.yml"),
                                    ReadCalibrationFile(extri, "EasyMocap's extri.yml"), intri, extri);

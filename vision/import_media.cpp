@@ -9,6 +9,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "core/error.h"
+#include "core/file_status.h"
 #include "vision/natural_order.h"
 
 namespace subflow::vision {
@@ -36,7 +37,7 @@ bool Hidden(const fs::path& path) { return path.filename().string().rfind('.', 0
 std::vector<std::string> ImagesIn(const fs::path& folder) {
   std::vector<std::string> files;
   for (const auto& entry : fs::directory_iterator(folder))
-    if (!Hidden(entry.path()) && entry.is_regular_file() && IsImageExtension(Lower(entry.path().extension().string())))
+    if (!Hidden(entry.path()) && IsFile(entry.path()) && IsImageExtension(Lower(entry.path().extension().string())))
       files.push_back(fs::absolute(entry.path()).lexically_normal().string());
   std::sort(files.begin(), files.end(), NaturalLess);
   return files;
@@ -129,16 +130,16 @@ MediaSearch FindCameraMedia(const Calibration& calibration, const std::string& v
                             const std::string& name_pattern) {
   const bool use_videos = !videos.empty();
   const fs::path folder(use_videos ? videos : images);
-  if (!fs::is_directory(folder))
+  if (!IsDirectory(folder))
     ThrowError(folder.string(), "", use_videos ? "not a directory (expected a folder of one video per camera)"
                                                : "not a directory (expected a folder of images per camera)");
   std::vector<fs::path> paths;
   std::vector<std::string> entries;
   for (const auto& entry : fs::directory_iterator(folder)) {
     if (Hidden(entry.path())) continue;
-    const bool directory = entry.is_directory();
-    if (use_videos ? !entry.is_regular_file()
-                   : !(directory || (entry.is_regular_file() &&
+    const bool directory = IsDirectory(entry.path());
+    if (use_videos ? !IsFile(entry.path())
+                   : !(directory || (IsFile(entry.path()) &&
                                      IsImageExtension(Lower(entry.path().extension().string())))))
       continue;
     paths.push_back(entry.path());
@@ -153,14 +154,14 @@ MediaSearch FindCameraMedia(const Calibration& calibration, const std::string& v
   for (std::size_t c = 0; c < names.size(); ++c) {
     if (match[c] < 0) {
       const std::string& hint = calibration.cameras[c].image_name;
-      if (!use_videos && !hint.empty() && fs::is_regular_file(folder / hint))
+      if (!use_videos && !hint.empty() && IsFile(folder / hint))
         search.media[c] = ProbeImages(names[c], {fs::absolute(folder / hint).lexically_normal().string()},
                                       (folder / hint).string());
       continue;
     }
     const fs::path& path = paths[match[c]];
     if (use_videos) search.media[c] = ProbeVideo(names[c], path);
-    else if (fs::is_directory(path)) search.media[c] = ProbeImages(names[c], ImagesIn(path), path.string());
+    else if (IsDirectory(path)) search.media[c] = ProbeImages(names[c], ImagesIn(path), path.string());
     else search.media[c] = ProbeImages(names[c], {fs::absolute(path).lexically_normal().string()}, path.string());
   }
   for (std::size_t e = 0; e < entries.size(); ++e)

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/error.h"
+#include "core/file_status.h"
 
 namespace subflow::vision {
 namespace fs = std::filesystem;
@@ -24,12 +25,14 @@ std::string Trim(const std::string& text) {
   return text.substr(begin, text.find_last_not_of(" \t\r\n") - begin + 1);
 }
 
-// Size of the image at `path`, or of the image called <stem>.<ext> in `folder`.
+// Size of the image at `path`; false when there is none. An entry that is there but no
+// readable image (empty, a folder, a link to nothing or to itself) is an error naming it.
 bool ImageSize(const fs::path& path, int* width, int* height) {
   std::error_code error;  // a name too long for the filesystem is no image, not a crash
-  if (!fs::is_regular_file(path, error)) return false;
-  const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty()) return false;
+  const fs::file_status entry = fs::symlink_status(path, error);
+  if (error || entry.type() == fs::file_type::not_found) return false;
+  const cv::Mat image = IsFile(path) ? cv::imread(path.string(), cv::IMREAD_UNCHANGED) : cv::Mat();
+  if (image.empty()) ThrowError(path.string(), "", "not a readable image (expected the camera's image, for its size)");
   *width = image.cols;
   *height = image.rows;
   return true;
@@ -107,11 +110,15 @@ Camera CameraFromProjectionMatrix(const Eigen::Matrix<double, 3, 4>& P, std::str
 
 Calibration ReadProjectionMatrixCalibration(const std::string& directory,
                                             const ProjectionMatrixImportOptions& options, bool require_sizes) {
-  if (!fs::is_directory(directory))
+  if (!IsDirectory(directory))
     ThrowError(directory, "", "not a directory (expected a folder of 3×4 projection-matrix files)");
   std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(directory))
-    if (entry.is_regular_file() && entry.path().extension() == options.extension) files.push_back(entry.path());
+  for (const auto& entry : fs::directory_iterator(directory)) {
+    if (entry.path().extension() != options.extension) continue;
+    if (!IsFile(entry.path()))  // a folder or a link to nothing under a matrix file's name
+      ThrowError(entry.path().string(), "", "not a readable file (expected a 3×4 projection matrix)");
+    files.push_back(entry.path());
+  }
   std::sort(files.begin(), files.end());
   if (files.empty())
     ThrowError(directory, "", "no *" + options.extension + " projection-matrix files");

@@ -74,6 +74,7 @@ std::string ToString(EvidenceSource source) {
     case EvidenceSource::kMask: return "mask";
     case EvidenceSource::kBackground: return "background";
     case EvidenceSource::kMotion: return "motion";
+    case EvidenceSource::kStill: return "still";
   }
   return "?";
 }
@@ -83,10 +84,10 @@ std::string ToString(ThresholdMethod method) {
 }
 
 EvidenceSource ParseEvidenceSource(const std::string& text, const std::string& field) {
-  for (EvidenceSource source : {EvidenceSource::kAuto, EvidenceSource::kMask,
-                                EvidenceSource::kBackground, EvidenceSource::kMotion})
+  for (EvidenceSource source : {EvidenceSource::kAuto, EvidenceSource::kMask, EvidenceSource::kBackground,
+                                EvidenceSource::kMotion, EvidenceSource::kStill})
     if (text == ToString(source)) return source;
-  ThrowError("", field, "expected auto, mask, background or motion, got \"" + text + "\"");
+  ThrowError("", field, "expected auto, mask, background, motion or still, got \"" + text + "\"");
 }
 
 void SilhouetteOptions::Check() const {
@@ -441,6 +442,22 @@ EstimatedBackground EstimateBackground(const std::vector<cv::Mat>& images,
           free_total += n;
         }
       }
+    }
+  }
+  // Instability: the median absolute deviation of the gray free samples from their median.
+  result.instability = cv::Mat::zeros(rows, cols, CV_32FC1);
+  for (int y = 0; y < rows; ++y) {
+    float* out = result.instability.ptr<float>(y);
+    for (int x = 0; x < cols; ++x) {
+      int n = 0;
+      for (int g = 0; g < count; ++g)
+        if (free[g].at<uint8_t>(y, x)) values[n++] = gray_frames[g].at<float>(y, x);
+      if (n == 0) continue;
+      std::nth_element(values.begin(), values.begin() + (n - 1) / 2, values.begin() + n);
+      const float median = values[(n - 1) / 2];
+      for (int i = 0; i < n; ++i) values[i] = std::abs(values[i] - median);
+      std::nth_element(values.begin(), values.begin() + (n - 1) / 2, values.begin() + n);
+      out[x] = values[(n - 1) / 2];
     }
   }
   result.known_fraction = static_cast<double>(known) / (static_cast<double>(rows) * cols);

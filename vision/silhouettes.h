@@ -52,8 +52,11 @@ enum class EvidenceSource {
   kMask,
   kBackground,
   kMotion,
+  // Photo-consistency of a still image set (vision/still_evidence.h): computed by shape
+  // initialization (solver/shape/shape_init.h) when nothing moves, or when asked for.
+  kStill,
 };
-// "auto", "mask", "background", "motion" (as written in report.json and read by the CLI).
+// "auto", "mask", "background", "motion", "still" (as written in report.json and read by the CLI).
 std::string ToString(EvidenceSource source);
 // Inverse of ToString; throws subflow::Error naming `field` on anything else.
 EvidenceSource ParseEvidenceSource(const std::string& text, const std::string& field = "source");
@@ -259,6 +262,11 @@ Silhouette SilhouetteFromMotion(const std::vector<cv::Mat>& gray_frames, int ind
 struct EstimatedBackground {
   cv::Mat image;  // CV_32FC1 or CV_32FC3 in [0, 1] (the frames' channels, alpha dropped); empty = none
   cv::Mat known;  // CV_8UC1, 255 where the pixel was free in at least one frame
+  // CV_32FC1: per pixel, the median absolute deviation of the gray free samples from their
+  // median (0 where unknown): sensor and compression noise on the static scene, more
+  // where something in it sways — a person standing (almost) still, whom the median
+  // keeps (vision/standing_evidence.h).
+  cv::Mat instability;
   int frames = 0;                 // frames of the video the estimate was made from
   double known_fraction = 0;      // fraction of the pixels that are known
   double mean_free_frames = 0;    // mean number of frames a known pixel was free in

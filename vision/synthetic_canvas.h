@@ -33,7 +33,6 @@ struct CanvasHit {
 class SampleCanvas {
  public:
   SampleCanvas(const Camera& camera, int factor);
-  const Camera& canvas_camera() const { return canvas_; }
   // Renders (V, F) into the canvas.
   void Render(const geometry::Positions& V, const geometry::Faces& F, const ZBufferOptions& options);
   // The hit of the sample (i, j) of raw pixel (x, y): raw point ((s x + i + ½)/s − ½, …).

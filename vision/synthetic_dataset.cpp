@@ -1,7 +1,6 @@
 // Writing a synthetic dataset (vision/synthetic_render.h's WriteSyntheticDataset).
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -14,6 +13,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/stopwatch.h"
 #include "geometry/vertex_normals.h"
 #include "vision/dataset_writer.h"
 #include "vision/synthetic_render.h"
@@ -109,7 +109,7 @@ class VideoFiles {
 
 SynthSummary WriteSyntheticDataset(const std::string& directory, const SynthOptions& options,
                                    Progress* progress) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch stopwatch;
   options.Check();
   const SyntheticScene scene = MakeSyntheticScene(options.scene, progress);
 
@@ -156,7 +156,7 @@ SynthSummary WriteSyntheticDataset(const std::string& directory, const SynthOpti
     });
   }
 
-  const auto render_start = std::chrono::steady_clock::now();
+  const Stopwatch render_stopwatch;
   const int task_count = camera_count * frame_count;
   ProgressBegin(progress, "synth: rendering " + std::to_string(task_count) + " images",
                 static_cast<std::size_t>(task_count));
@@ -186,9 +186,8 @@ SynthSummary WriteSyntheticDataset(const std::string& directory, const SynthOpti
   }
   if (videos) videos->Finish(directory);
   ProgressEnd(progress);
-  const auto end = std::chrono::steady_clock::now();
-  summary.render_seconds = std::chrono::duration<double>(end - render_start).count();
-  summary.seconds = std::chrono::duration<double>(end - start).count();
+  summary.render_seconds = render_stopwatch.Seconds();
+  summary.seconds = stopwatch.Seconds();
   return summary;
 }
 

@@ -46,8 +46,6 @@ struct EnvironmentOptions {
   double shadow_bias = 0.002;       // metres along the light's depth
 
   void Check() const;  // throws subflow::Error naming the option
-  bool HasStaticGeometry() const { return kind != "none"; }
-  bool HasMovers() const { return distractors != "none"; }
 };
 
 // A mesh with rest (texture) coordinates.

@@ -224,14 +224,6 @@ Eigen::Vector3d ZBuffer::SurfacePoint(int x, int y, const geometry::Positions& V
          uv.x() * V.row(F(f, 1)).transpose() + uv.y() * V.row(F(f, 2)).transpose();
 }
 
-cv::Mat ZBuffer::DepthImage() const {
-  return cv::Mat(height_, width_, CV_32FC1, const_cast<float*>(depth_.data())).clone();
-}
-
-cv::Mat ZBuffer::FaceImage() const {
-  return cv::Mat(height_, width_, CV_32SC1, const_cast<int*>(face_.data())).clone();
-}
-
 cv::Mat ZBuffer::Mask() const {
   cv::Mat mask(height_, width_, CV_8UC1);
   for (int y = 0; y < height_; ++y) {

@@ -70,8 +70,6 @@ class ZBuffer {
   const std::vector<int>& faces() const { return face_; }
   const std::vector<float>& barycentrics() const { return barycentric_; }
 
-  cv::Mat DepthImage() const;  // CV_32FC1, +inf where empty
-  cv::Mat FaceImage() const;   // CV_32SC1, −1 where empty
   cv::Mat Mask() const;        // CV_8UC1 silhouette: 255 where covered, else 0
   int CoveredPixelCount() const;
 

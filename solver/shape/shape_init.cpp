@@ -60,25 +60,32 @@ void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std:
 }
 
 // The visual hull of every frame (FrameShapeInit's carving, hull and times) from the
-// evidence of `silhouettes`; has_evidence / all_empty per frame as
-// TakeHullsOfFramesWithoutEvidence reads them.
+// evidence of `silhouettes` (plus `standing`, when given), or from `still` for every frame
+// when given; has_evidence / all_empty per frame as TakeHullsOfFramesWithoutEvidence
+// reads them.
 struct HullStage {
   const vision::Dataset& dataset;
   const vision::VoxelCarvingOptions& carving;
   const geometry::IsosurfaceOptions& isosurface;
   const std::vector<vision::Camera>& cameras;  // the evidence's working cameras
   const std::vector<vision::EstimatedBackground>& estimated;
+  const std::vector<vision::Silhouette>* standing = nullptr;
 
-  void Run(const vision::SilhouetteOptions& silhouette_options, Progress* progress,
-           std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
+  void Run(const vision::SilhouetteOptions& silhouette_options, const std::vector<vision::Silhouette>* still,
+           Progress* progress, std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
            std::vector<bool>* all_empty) const {
     const int count = static_cast<int>(frames->size());
     ProgressBegin(progress, "visual hull", count);
     for (int i = 0; i < count; ++i) {
       FrameShapeInit& frame = (*frames)[i];
       Stopwatch start;
-      const std::vector<vision::Silhouette> silhouettes =
-          vision::ComputeFrameEvidence(dataset, frame.frame, silhouette_options, &estimated, &cameras);
+      std::vector<vision::Silhouette> silhouettes;
+      if (still) {
+        silhouettes = *still;
+      } else {
+        silhouettes = vision::ComputeFrameEvidence(dataset, frame.frame, silhouette_options, &estimated, &cameras);
+        if (standing) vision::AddStandingEvidence(*standing, &silhouettes);
+      }
       (*has_evidence)[i] = !vision::LacksEvidence(silhouettes, carving.min_cameras);
       // Empty masks or background differences say the object is absent (motion evidence
       // only that nothing moves).
@@ -100,6 +107,41 @@ struct HullStage {
   }
 };
 
+// The standing silhouette of every camera with an estimated background (none when the
+// option is off or nothing was estimated).
+std::vector<vision::Silhouette> StandingSilhouettes(const std::vector<vision::EstimatedBackground>& estimated,
+                                                    const ShapeInitOptions& options) {
+  if (!options.standing.enabled || estimated.empty()) return {};
+  std::vector<vision::Silhouette> standing(estimated.size());
+  for (std::size_t k = 0; k < estimated.size(); ++k)
+    standing[k] = vision::StandingSilhouette(estimated[k], options.silhouettes, options.standing);
+  return standing;
+}
+
+// The still evidence of the reference frame (vision/still_evidence.h) as silhouettes of
+// source kStill, on the evidence's working cameras.
+std::vector<vision::Silhouette> StillSilhouettes(const vision::Dataset& dataset, int reference,
+                                                 const std::vector<vision::Camera>& cameras, int resolution,
+                                                 const ShapeInitOptions& options, ShapeInitResult* result) {
+  std::vector<cv::Mat> gray(cameras.size());
+  for (std::size_t k = 0; k < cameras.size(); ++k)
+    gray[k] = vision::ResizeToCamera(dataset.Gray(static_cast<int>(k), reference), cameras[k]);
+  result->still = vision::ComputeStillEvidence(cameras, gray, dataset.bounds(), resolution, options.still);
+  result->used_still = true;
+  std::vector<vision::Silhouette> silhouettes(cameras.size());
+  for (std::size_t k = 0; k < cameras.size(); ++k) {
+    silhouettes[k] = vision::SilhouetteFromMask(result->still.silhouettes[k], options.silhouettes);
+    silhouettes[k].source = vision::EvidenceSource::kStill;
+  }
+  for (cv::Mat& silhouette : result->still.silhouettes) silhouette.release();  // memory: keep the figures
+  result->still.fused.occupancy = geometry::ScalarVolume();
+  spdlog::info("no masks, no background and nothing moves: photo-consistency of frame {} ({} voxels, support "
+               "plane {}, {:.1f} s)",
+               reference, result->still.fused.occupied_voxels,
+               result->still.support.found ? "removed" : "not found", result->still.seconds);
+  return silhouettes;
+}
+
 }  // namespace
 
 std::string ShapeInitResult::BriefReport() const {
@@ -118,11 +160,19 @@ std::string ShapeInitResult::BriefReport() const {
 }
 
 void ShapeInitOptions::Check() const {
+  silhouettes.Check();
+  standing.Check();
+  still.Check();
   carving.Check();
   isosurface.Check();
   simplify.Check();
   fit.Check();
-  if (levels < 0 || levels > 6) ThrowError("shape init options", "levels", "expected 0..6");
+  if (levels < -1 || levels > 6) ThrowError("shape init options", "levels", "expected 0..6, or −1 for automatic");
+  if (!(base_distance_voxels >= 0 && base_distance_voxels <= 100))
+    ThrowError("shape init options", "base_distance_voxels", "expected 0 (by count) or a distance in (0, 100] voxels");
+  if (!(finest_edge_pixels >= 0.25 && finest_edge_pixels <= 1000))
+    ThrowError("shape init options", "finest_edge_pixels", "expected a length in [0.25, 1000] pixels");
+  if (max_finest_faces < 4) ThrowError("shape init options", "max_finest_faces", "expected at least 4");
   if (first_frame < 0) ThrowError("shape init options", "first_frame", "expected ≥ 0");
   if (frame_count == 0 || frame_count < -1)
     ThrowError("shape init options", "frame_count", "expected > 0, or −1 for all frames");
@@ -177,26 +227,46 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
       break;
     }
 
-  // Visual hull of every frame with evidence.
+  // Visual hull of every frame with evidence; when no frame has any, of the still set.
   std::vector<bool> has_evidence(count, false), all_empty(count, false);
-  const HullStage stage{dataset, carving, options.isosurface, evidence_cameras, result.estimated_backgrounds};
-  stage.Run(options.silhouettes, progress, &result.frames, &has_evidence, &all_empty);
+  result.standing = StandingSilhouettes(result.estimated_backgrounds, options);
+  const HullStage stage{dataset, carving, options.isosurface, evidence_cameras, result.estimated_backgrounds,
+                        result.standing.empty() ? nullptr : &result.standing};
+  const bool still_forced = options.silhouettes.source == vision::EvidenceSource::kStill;
+  std::vector<vision::Silhouette> still;
+  if (still_forced) still = StillSilhouettes(dataset, reference, evidence_cameras, carving.resolution, options, &result);
+  stage.Run(options.silhouettes, still_forced ? &still : nullptr, progress, &result.frames, &has_evidence,
+            &all_empty);
+  const bool none = std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end();
+  if (!still_forced && none && options.still.enabled && options.silhouettes.source == vision::EvidenceSource::kAuto &&
+      std::find(all_empty.begin(), all_empty.end(), false) != all_empty.end()) {
+    still = StillSilhouettes(dataset, reference, evidence_cameras, carving.resolution, options, &result);
+    stage.Run(options.silhouettes, &still, progress, &result.frames, &has_evidence, &all_empty);
+  }
   for (vision::EstimatedBackground& estimated : result.estimated_backgrounds)  // memory: keep the figures
-    estimated.image.release(), estimated.known.release();
+    estimated.image.release(), estimated.known.release(), estimated.instability.release();
+  for (vision::Silhouette& standing : result.standing)
+    standing.evidence.release(), standing.mask.release(), standing.measure.release();
+  if (result.used_still && std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end())
+    ThrowError(dataset.directory(), "evidence",
+               "no masks, no background, nothing moves, and the photo-consistency of the still set (evidence "
+               "\"still\") found no surface either: cannot find the object (give masks or background images)");
   TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames);
 
   // Base mesh and hierarchy from the reference frame.
   Stopwatch start;
   const FrameShapeInit& reference_frame = result.frames[reference - first];
-  result.base_mesh = geometry::SimplifyMesh(reference_frame.hull, options.simplify,
-                                            &result.simplify,
-                                            "visual hull of frame " + vision::FrameName(reference));
+  result.resolution = ChooseBaseResolution(reference_frame.hull, dataset.cameras(), voxel_size, options,
+                                           "visual hull of frame " + vision::FrameName(reference));
+  result.base_mesh = std::move(result.resolution.base);
+  result.simplify = result.resolution.simplify;
   result.simplify_seconds = start.Seconds();
+  const int levels = result.resolution.levels;
   result.hierarchy = std::make_shared<const geometry::LoopHierarchy>(
-      result.base_mesh.F, result.base_mesh.vertex_count(), options.levels, "base mesh");
+      result.base_mesh.F, result.base_mesh.vertex_count(), levels, "base mesh");
   spdlog::info("base mesh: {} vertices, {} faces; {} levels, finest {} faces",
-               result.base_mesh.vertex_count(), result.base_mesh.face_count(), options.levels,
-               result.hierarchy->FaceCount(options.levels));
+               result.base_mesh.vertex_count(), result.base_mesh.face_count(), levels,
+               result.hierarchy->FaceCount(levels));
 
   // Fit the hierarchy to every frame's hull, outwards from the reference frame.
   ProgressBegin(progress, "fit subdivision surface", count);

@@ -4,8 +4,10 @@
 //   per frame f:  silhouettes (mask | background difference | motion evidence, eq. 23)
 //                 → evidence voxels → 3D morphology → occupancy        (vision/voxel_carving.h)
 //                 → iso-surface: the visual hull H_f                     (geometry/isosurface.h)
-//   reference frame r:  T0 = simplification of H_r (Garland–Heckbert)   (geometry/simplify.h)
-//                 → LoopHierarchy of T0 with `levels` levels
+//   reference frame r:  T0 = simplification of H_r to a distance bound, and the number of
+//                 levels, from the subject's detail and the images' resolution
+//                 (solver/shape/base_resolution.h, geometry/simplify.h)
+//                 → LoopHierarchy of T0 with that many levels
 //   every frame:  control points of levels 0..n fitted to H_f along limit normals
 //                 (solver/shape/hierarchy_fit.h), frames visited outwards from r so that each
 //                 starts from its neighbour's fitted base; MultiresShape by analysis.
@@ -24,21 +26,43 @@
 #include "geometry/multires_shape.h"
 #include "core/progress.h"
 #include "geometry/simplify.h"
+#include "solver/shape/base_resolution.h"
 #include "solver/shape/hierarchy_fit.h"
 #include "vision/dataset.h"
 #include "vision/silhouettes.h"
+#include "vision/standing_evidence.h"
+#include "vision/still_evidence.h"
 #include "vision/voxel_carving.h"
 
 namespace subflow::solver {
 
 struct ShapeInitOptions {
   vision::SilhouetteOptions silhouettes;
+  // Cameras whose silhouettes come from a background estimated from the video: what
+  // stands (almost) still in the take is added to them (vision/standing_evidence.h).
+  vision::StandingEvidenceOptions standing;
+  // When no frame has any evidence (no masks, no background images, nothing moves: a
+  // still set of one frame, or a take in which nobody moves), or with silhouettes.source
+  // kStill: the photo-consistency of the still set formed by the reference frame of every
+  // camera (vision/still_evidence.h) is every frame's evidence.
+  vision::StillEvidenceOptions still;
   vision::VoxelCarvingOptions carving;
   geometry::IsosurfaceOptions isosurface;
-  geometry::SimplifyOptions simplify;  // target_face_count = faces of the base mesh T0
+  // T0's simplification: its filters, the face count when base_distance_voxels = 0, the
+  // face floor and cap of the distance bound (min_face_count, max_face_count) otherwise.
+  geometry::SimplifyOptions simplify;
   HierarchyFitOptions fit;
-  // Subdivision levels above the base mesh (the hierarchy has levels 0..levels).
-  int levels = 3;
+  // T0 = the reference hull simplified until it would leave this many voxels (of the
+  // carving grid) of the hull, both ways (solver/shape/base_resolution.h); 0 = by count
+  // (simplify.target_face_count faces).
+  double base_distance_voxels = 1.0;
+  // Subdivision levels above the base mesh (the hierarchy has levels 0..levels); −1 =
+  // automatic: the fewest whose finest edges project to about finest_edge_pixels where
+  // the subject is smooth (T0's faces raised to match; base_resolution.h), within
+  // max_finest_faces faces at the finest level.
+  int levels = -1;
+  double finest_edge_pixels = 2.0;
+  int max_finest_faces = 2000000;
   // Frame whose visual hull gives the base connectivity; −1 = the middle frame.
   int reference_frame = -1;
   // Frames [first_frame, first_frame + frame_count); frame_count −1 = to the end.
@@ -78,6 +102,8 @@ struct ShapeInitResult {
   int reference_frame = 0;
   geometry::TriangleMesh base_mesh;  // T0 (level 0 at the reference frame, before fitting)
   geometry::SimplifySummary simplify;
+  // How T0 and the levels were chosen (base_resolution.h; its `base` is moved to base_mesh).
+  BaseResolution resolution;
   std::shared_ptr<const geometry::LoopHierarchy> hierarchy;
   std::vector<FrameShapeInit> frames;  // in frame order
   // Per camera, the background estimated from the video (vision::EstimateBackgrounds;
@@ -85,6 +111,12 @@ struct ShapeInitResult {
   // empty when none was estimated.
   std::vector<vision::EstimatedBackground> estimated_backgrounds;
   double estimate_background_seconds = 0;
+  // Per camera, the standing silhouette added to every frame's (vision/standing_evidence.h;
+  // masks released, figures kept); empty when none was computed.
+  std::vector<vision::Silhouette> standing;
+  // The still set's evidence, when it was used (used_still; silhouettes released).
+  bool used_still = false;
+  vision::StillEvidence still;
   // Per camera, the scale of the images the evidence was computed on (1 = stored size;
   // VoxelCarvingOptions::max_pixels_per_voxel).
   std::vector<double> evidence_scales;

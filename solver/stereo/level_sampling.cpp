@@ -14,7 +14,7 @@ using geometry::Positions;
 
 LevelSampling SampleLevel(const LoopHierarchy& hierarchy, int level, const Positions& level_control,
                           const std::vector<vision::Camera>& cameras,
-                          const StereoRefinementOptions& options) {
+                          const StereoRefinementOptions& options, const std::vector<char>* active_faces) {
   SurfaceSamplingOptions sampling;
   sampling.samples_per_pixel = options.samples_per_pixel;
   sampling.max_density = options.max_density;
@@ -23,7 +23,8 @@ LevelSampling SampleLevel(const LoopHierarchy& hierarchy, int level, const Posit
   const int faces = hierarchy.FaceCount(level);
   for (int f = 0; f < faces; ++f) {
     result.face_first.push_back(static_cast<int>(result.samples.size()));
-    AppendFaceSamplePattern(f, std::max(density[f], options.min_density), &result.samples);
+    if (active_faces == nullptr || (*active_faces)[f])
+      AppendFaceSamplePattern(f, std::max(density[f], options.min_density), &result.samples);
   }
   result.face_first.push_back(static_cast<int>(result.samples.size()));
 

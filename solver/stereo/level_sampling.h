@@ -31,10 +31,12 @@ struct LevelSampling {
 };
 
 // Samples of `level` for the level's control points `level_control` (#V(ℓ)×3, the
-// densities follow their projected areas in `cameras`).
+// densities follow their projected areas in `cameras`); with `active_faces` (#F(ℓ)), only
+// the faces marked 1 get samples (the others an empty range).
 LevelSampling SampleLevel(const geometry::LoopHierarchy& hierarchy, int level,
                           const geometry::Positions& level_control,
                           const std::vector<vision::Camera>& cameras,
-                          const StereoRefinementOptions& options);
+                          const StereoRefinementOptions& options,
+                          const std::vector<char>* active_faces = nullptr);
 
 }  // namespace subflow::solver

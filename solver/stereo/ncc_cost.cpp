@@ -114,47 +114,44 @@ Eigen::VectorXd NormalizeIntensities(const Eigen::VectorXd& x, double epsilon,
   return normalized;
 }
 
+std::vector<std::vector<int>> RowsOfViews(const std::vector<CorrelationPair>& pairs, int views, int samples) {
+  std::vector<std::vector<char>> needed(views, std::vector<char>(samples, 0));
+  for (const CorrelationPair& pair : pairs) {
+    if (pair.a < 0 || pair.a >= views || pair.b < 0 || pair.b >= views || pair.a == pair.b ||
+        pair.rows.size() < 2 || !(pair.weight >= 0.0))
+      ThrowError("PatchCorrelationCost", "pair",
+                 "needs two different views, at least 2 sample rows and a weight ≥ 0");
+    for (int row : pair.rows) {
+      if (row < 0 || row >= samples) ThrowError("PatchCorrelationCost", "pair rows", "sample index out of range");
+      needed[pair.a][row] = needed[pair.b][row] = 1;
+    }
+  }
+  std::vector<std::vector<int>> rows(views);
+  for (int v = 0; v < views; ++v)
+    for (int k = 0; k < samples; ++k)
+      if (needed[v][k]) rows[v].push_back(k);
+  return rows;
+}
+
 PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, std::vector<PatchView> views,
                                            std::vector<CorrelationPair> pairs, int block_count,
                                            int dof, double epsilon)
     : stencil_(std::move(stencil)),
       views_(std::move(views)),
       pairs_(std::move(pairs)),
+      support_(static_cast<int>(stencil_.cols())),
       dof_(dof),
       epsilon_(epsilon) {
   const auto support = static_cast<std::size_t>(stencil_.cols());
   const auto m = static_cast<std::size_t>(stencil_.rows());
-  if (dof != 1 && dof != 3) ThrowError("PatchCorrelationCost", "dof", "must be 1 or 3");
-  if (!(epsilon >= 0.0)) ThrowError("PatchCorrelationCost", "epsilon", "must be finite and ≥ 0");
-  if (pairs_.empty()) ThrowError("PatchCorrelationCost", "pairs", "needs at least one pair");
   for (const PatchView& view : views_) {
-    if (!view.image || !view.camera || view.base.size() != m || view.basis.size() != support ||
-        view.first_block < 0 || view.first_block + static_cast<int>(support) > block_count)
+    if (!view.image || !view.camera || view.base.size() != m || view.basis.size() != support)
       ThrowError("PatchCorrelationCost", "view",
                  "needs an image, a camera, one position per sample and one basis per support "
                  "vertex, with its blocks inside the block count");
+    first_blocks_.push_back(view.first_block);
   }
-  std::vector<std::vector<char>> needed(views_.size(), std::vector<char>(m, 0));
-  int residuals = 0;
-  for (const CorrelationPair& pair : pairs_) {
-    const int views = static_cast<int>(views_.size());
-    if (pair.a < 0 || pair.a >= views || pair.b < 0 || pair.b >= views || pair.a == pair.b ||
-        pair.rows.size() < 2 || !(pair.weight >= 0.0))
-      ThrowError("PatchCorrelationCost", "pair",
-                 "needs two different views, at least 2 sample rows and a weight ≥ 0");
-    for (int row : pair.rows) {
-      if (row < 0 || row >= static_cast<int>(m))
-        ThrowError("PatchCorrelationCost", "pair rows", "sample index out of range");
-      needed[pair.a][row] = needed[pair.b][row] = 1;
-    }
-    residuals += static_cast<int>(pair.rows.size());
-  }
-  view_rows_.resize(views_.size());
-  for (std::size_t v = 0; v < views_.size(); ++v)
-    for (std::size_t k = 0; k < m; ++k)
-      if (needed[v][k]) view_rows_[v].push_back(static_cast<int>(k));
-  set_num_residuals(residuals);
-  for (int i = 0; i < block_count; ++i) mutable_parameter_block_sizes()->push_back(dof);
+  Setup(static_cast<int>(views_.size()), static_cast<int>(m), block_count);
 }
 
 PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, PatchView a, PatchView b,
@@ -170,21 +167,63 @@ PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, PatchView a, Pa
                            weight}},
           block_count, dof, epsilon) {}
 
+PatchCorrelationCost::PatchCorrelationCost(std::vector<const SampledView*> sampled, std::vector<int> first_blocks,
+                                           std::vector<CorrelationPair> pairs, int support, int block_count,
+                                           int dof, double epsilon)
+    : sampled_(std::move(sampled)),
+      first_blocks_(std::move(first_blocks)),
+      pairs_(std::move(pairs)),
+      support_(support),
+      dof_(dof),
+      epsilon_(epsilon) {
+  if (first_blocks_.size() != sampled_.size() ||
+      std::find(sampled_.begin(), sampled_.end(), nullptr) != sampled_.end())
+    ThrowError("PatchCorrelationCost", "sampled views", "needs one sampled view and one first block per view");
+  int samples = 0;
+  for (const SampledView* view : sampled_) samples = std::max(samples, static_cast<int>(view->intensities.size()));
+  for (const CorrelationPair& pair : pairs_)
+    for (int row : pair.rows) samples = std::max(samples, row + 1);  // rows beyond a view's size fail below
+  Setup(static_cast<int>(sampled_.size()), samples, block_count);
+}
+
+void PatchCorrelationCost::Setup(int views, int samples, int block_count) {
+  if (dof_ != 1 && dof_ != 3) ThrowError("PatchCorrelationCost", "dof", "must be 1 or 3");
+  if (!(epsilon_ >= 0.0)) ThrowError("PatchCorrelationCost", "epsilon", "must be finite and ≥ 0");
+  if (pairs_.empty()) ThrowError("PatchCorrelationCost", "pairs", "needs at least one pair");
+  for (int first : first_blocks_)
+    if (first < 0 || first + support_ > block_count)
+      ThrowError("PatchCorrelationCost", "view",
+                 "needs an image, a camera, one position per sample and one basis per support "
+                 "vertex, with its blocks inside the block count");
+  view_rows_ = RowsOfViews(pairs_, views, samples);
+  for (std::size_t v = 0; v < sampled_.size(); ++v)
+    if (!view_rows_[v].empty() && view_rows_[v].back() >= sampled_[v]->intensities.size())
+      ThrowError("PatchCorrelationCost", "sampled views", "a pair compares a row the view does not have");
+  int residuals = 0;
+  for (const CorrelationPair& pair : pairs_) residuals += static_cast<int>(pair.rows.size());
+  set_num_residuals(residuals);
+  for (int i = 0; i < block_count; ++i) mutable_parameter_block_sizes()->push_back(dof_);
+}
+
 bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* residuals,
                                     double** jacobians) const {
-  const int columns = static_cast<int>(stencil_.cols()) * dof_;
+  const int columns = support_ * dof_;
   // Per-thread scratch: Ceres evaluates blocks concurrently, and this is the hot path.
-  thread_local std::vector<Eigen::VectorXd> intensities;
-  thread_local std::vector<RowJacobian> view_jacobians;
+  thread_local std::vector<SampledView> own;
+  thread_local std::vector<const SampledView*> views;
   thread_local Eigen::VectorXd xa, xb;
   thread_local RowJacobian ja, jb;
-  if (intensities.size() < views_.size()) {
-    intensities.resize(views_.size());
-    view_jacobians.resize(views_.size());
+  if (sampled_.empty()) {
+    if (own.size() < views_.size()) own.resize(views_.size());
+    views.resize(views_.size());
+    for (std::size_t v = 0; v < views_.size(); ++v) {
+      SampleView(views_[v], stencil_, dof_, parameters, &own[v].intensities,
+                 jacobians ? &own[v].jacobian : nullptr, &view_rows_[v]);
+      views[v] = &own[v];
+    }
+  } else {
+    views.assign(sampled_.begin(), sampled_.end());
   }
-  for (std::size_t v = 0; v < views_.size(); ++v)
-    SampleView(views_[v], stencil_, dof_, parameters, &intensities[v],
-               jacobians ? &view_jacobians[v] : nullptr, &view_rows_[v]);
 
   const int blocks = static_cast<int>(parameter_block_sizes().size());
   if (jacobians)
@@ -196,6 +235,8 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
   for (const CorrelationPair& pair : pairs_) {
     const int n = static_cast<int>(pair.rows.size());
     const double sqrt_weight = std::sqrt(pair.weight);
+    const SampledView& a = *views[pair.a];
+    const SampledView& b = *views[pair.b];
     xa.resize(n);
     xb.resize(n);
     if (jacobians) {
@@ -204,18 +245,18 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
     }
     for (int i = 0; i < n; ++i) {
       const int k = pair.rows[i];
-      xa(i) = intensities[pair.a](k);
-      xb(i) = intensities[pair.b](k);
+      xa(i) = a.intensities(k);
+      xb(i) = b.intensities(k);
       if (jacobians) {
-        ja.row(i) = view_jacobians[pair.a].row(k);
-        jb.row(i) = view_jacobians[pair.b].row(k);
+        ja.row(i) = a.jacobian.row(k);
+        jb.row(i) = b.jacobian.row(k);
       }
     }
     NormalizeInPlace(xa, epsilon_, jacobians ? &ja : nullptr);
     NormalizeInPlace(xb, epsilon_, jacobians ? &jb : nullptr);
     Eigen::Map<Eigen::VectorXd>(residuals + offset, n) = sqrt_weight * (xa - xb);
     if (jacobians) {
-      const int first_a = views_[pair.a].first_block, first_b = views_[pair.b].first_block;
+      const int first_a = first_blocks_[pair.a], first_b = first_blocks_[pair.b];
       for (int block = 0; block < blocks; ++block) {
         if (!jacobians[block]) continue;
         Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(

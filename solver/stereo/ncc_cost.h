@@ -67,6 +67,13 @@ void SampleView(const PatchView& view, const PatchStencil& stencil, int dof,
                 double const* const* parameters, Eigen::VectorXd* intensities,
                 RowJacobian* jacobian, const std::vector<int>* rows = nullptr);
 
+// What SampleView gives for one view: intensities (m) and ∂x/∂e (m × #support·dof), on the
+// rows it was asked for (the others are zero).
+struct SampledView {
+  Eigen::VectorXd intensities;
+  RowJacobian jacobian;
+};
+
 // x̂ = (x − mean)/σ (see the file comment); when `d_normalized` is given, it is replaced
 // by ∂x̂/∂θ for ∂x/∂θ = *d_normalized on input (any column count).
 Eigen::VectorXd NormalizeIntensities(const Eigen::VectorXd& x, double epsilon,
@@ -78,6 +85,10 @@ struct CorrelationPair {
   std::vector<int> rows;  // sample indices (rows of the stencil), at least 2
   double weight = 1.0;    // W
 };
+
+// Per view (0 … views − 1): the sorted rows some pair compares it on. Throws subflow::Error
+// on a pair with a view or row out of range, equal views, fewer than 2 rows or W < 0.
+std::vector<std::vector<int>> RowsOfViews(const std::vector<CorrelationPair>& pairs, int views, int samples);
 
 // All correlations of one patch in one residual block: the stereo pairs of a frame (the
 // views share the frame's blocks), or the temporal self-correlations of a frame step (the
@@ -93,6 +104,13 @@ class PatchCorrelationCost final : public ceres::CostFunction {
   // A single pair (a, b) on all samples, weight W.
   PatchCorrelationCost(PatchStencil stencil, PatchView a, PatchView b, int block_count, int dof,
                        double weight, double epsilon);
+  // Views sampled elsewhere, once per evaluation point for every block that compares them
+  // (view_cache.h): view v's intensities and Jacobian are *sampled[v], valid on its rows of
+  // RowsOfViews(pairs); first_blocks[v] is the index, among this cost's blocks, of v's
+  // frame's block for support vertex 0 (as PatchView::first_block). `support` vertices.
+  PatchCorrelationCost(std::vector<const SampledView*> sampled, std::vector<int> first_blocks,
+                       std::vector<CorrelationPair> pairs, int support, int block_count, int dof,
+                       double epsilon);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
@@ -100,10 +118,16 @@ class PatchCorrelationCost final : public ceres::CostFunction {
   const std::vector<CorrelationPair>& pairs() const { return pairs_; }
 
  private:
+  // Checks the pairs and the block count; sets the residual and parameter block sizes.
+  void Setup(int views, int samples, int block_count);
+
   PatchStencil stencil_;
-  std::vector<PatchView> views_;
+  std::vector<PatchView> views_;              // sampled by Evaluate (first two constructors)
+  std::vector<const SampledView*> sampled_;   // or sampled elsewhere (third)
+  std::vector<int> first_blocks_;             // per view
   std::vector<CorrelationPair> pairs_;
   std::vector<std::vector<int>> view_rows_;  // the rows each view must sample
+  int support_;
   int dof_;
   double epsilon_;
 };

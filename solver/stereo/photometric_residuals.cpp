@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "solver/stereo/stereo_refinement.h"
+#include "solver/stereo/view_cache.h"
 
 namespace subflow::solver {
 namespace {
@@ -47,6 +48,42 @@ PatchView MakeView(RefinementWindow& window, int frame, int camera, int face, in
   return view;
 }
 
+// A view of `face`: (frame, camera) and the index of its frame's first support block in
+// the block's parameter list.
+struct ViewKey {
+  int frame, camera, first_block;
+};
+
+// The correlation block of `face` comparing `views` by `pairs`: on the window's view cache
+// when it has one (each view sampled once per evaluation point for all blocks), else
+// sampling its own views.
+PatchCorrelationCost* CorrelationCost(RefinementWindow& window, int face, const std::vector<ViewKey>& views,
+                                      std::vector<CorrelationPair> pairs, int block_count) {
+  const PatchStencil& stencil = window.sampling->stencil[face];
+  const std::vector<int>& support = window.sampling->support[face];
+  const double epsilon = window.options->ncc_epsilon;
+  if (!window.views) {
+    std::vector<PatchView> own;
+    for (const ViewKey& key : views) own.push_back(MakeView(window, key.frame, key.camera, face, key.first_block));
+    return new PatchCorrelationCost(stencil, std::move(own), std::move(pairs), block_count, window.dof, epsilon);
+  }
+  const std::vector<std::vector<int>> rows =
+      RowsOfViews(pairs, static_cast<int>(views.size()), static_cast<int>(stencil.rows()));
+  std::vector<const SampledView*> sampled;
+  std::vector<int> first_blocks;
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    const ViewKey& key = views[v];
+    std::vector<const double*> increments;
+    for (int vertex : support) increments.push_back(window.Increment(key.frame, vertex));
+    sampled.push_back(window.views->Add(
+        key.frame, key.camera, face, stencil, [&] { return MakeView(window, key.frame, key.camera, face, 0); },
+        std::move(increments), rows[v]));
+    first_blocks.push_back(key.first_block);
+  }
+  return new PatchCorrelationCost(std::move(sampled), std::move(first_blocks), std::move(pairs),
+                                  static_cast<int>(support.size()), block_count, window.dof, epsilon);
+}
+
 }  // namespace
 
 PatchCameras CamerasOfPatch(const RefinementWindow& window, int frame, int face) {
@@ -84,8 +121,8 @@ std::optional<ResidualRecord> AddStereoResidual(RefinementWindow& window, int fr
   const std::vector<int>& support = window.sampling->support[face];
   const int n_seen = static_cast<int>(seen.cameras.size());
   // Each camera's samples are evaluated once, however many pairs use them.
-  std::vector<PatchView> views;
-  for (int a = 0; a < n_seen; ++a) views.push_back(MakeView(window, frame, seen.cameras[a], face, 0));
+  std::vector<ViewKey> views;
+  for (int a = 0; a < n_seen; ++a) views.push_back({frame, seen.cameras[a], 0});
   std::vector<CorrelationPair> pairs;
   for (int a = 0; a < n_seen; ++a)
     for (int b = a + 1; b < n_seen; ++b) {
@@ -98,8 +135,8 @@ std::optional<ResidualRecord> AddStereoResidual(RefinementWindow& window, int fr
   if (pairs.empty()) return std::nullopt;
   std::vector<double*> blocks;
   AppendBlocks(window, frame, support, &blocks);
-  auto* cost = new PatchCorrelationCost(window.sampling->stencil[face], std::move(views), std::move(pairs),
-                                        static_cast<int>(support.size()), window.dof, options.ncc_epsilon);
+  PatchCorrelationCost* cost =
+      CorrelationCost(window, face, views, std::move(pairs), static_cast<int>(support.size()));
   return ResidualRecord{problem->AddResidualBlock(cost, loss, blocks), frame, cost};
 }
 
@@ -114,7 +151,7 @@ int AddTemporalResiduals(RefinementWindow& window, int frame, int face, const Pa
   if (frame == window.first && frame > 0) steps.emplace_back(frame - 1, frame);
   int added = 0;
   for (const auto& [ta, tb] : steps) {
-    std::vector<PatchView> views;
+    std::vector<ViewKey> views;
     std::vector<CorrelationPair> pairs;
     for (std::size_t a = 0; a < seen.cameras.size(); ++a) {
       const int i = seen.cameras[a];
@@ -123,18 +160,16 @@ int AddTemporalResiduals(RefinementWindow& window, int frame, int face, const Pa
       const double weight = options.temporal_weight *
                             std::pow(std::max(0.0, seen.cosines[a]), 2.0 * options.angle_weight_power);
       const int index = static_cast<int>(views.size());
-      views.push_back(MakeView(window, ta, i, face, 0));
-      views.push_back(MakeView(window, tb, i, face, support_size));
+      views.push_back({ta, i, 0});
+      views.push_back({tb, i, support_size});
       pairs.push_back({index, index + 1, std::move(rows), weight});
     }
     if (pairs.empty()) continue;
     std::vector<double*> blocks;
     AppendBlocks(window, ta, support, &blocks);
     AppendBlocks(window, tb, support, &blocks);
-    problem->AddResidualBlock(new PatchCorrelationCost(window.sampling->stencil[face], std::move(views),
-                                                       std::move(pairs), 2 * support_size, window.dof,
-                                                       options.ncc_epsilon),
-                              loss, blocks);
+    problem->AddResidualBlock(CorrelationCost(window, face, views, std::move(pairs), 2 * support_size), loss,
+                              blocks);
     ++added;
   }
   return added;

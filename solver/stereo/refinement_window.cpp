@@ -54,7 +54,7 @@ RefinementLevel PrepareLevel(const LoopHierarchy& hierarchy, const std::vector<v
   const int reference = static_cast<int>(trajectory.size()) / 2;
   const Positions reference_level = trajectory[reference].Synthesize(hierarchy, level);
   prepared.h = geometry::MeanEdgeLength(hierarchy.Topology(level), reference_level);
-  prepared.sampling = SampleLevel(hierarchy, level, reference_level, cameras, options);
+  prepared.sampling = SampleLevel(hierarchy, level, reference_level, cameras, options, &active_faces);
   prepared.visibility = std::make_unique<VisibilityTester>(hierarchy, hierarchy.finest_level(), options.visibility);
   prepared.active_faces = std::move(active_faces);
   return prepared;

@@ -35,6 +35,7 @@
 namespace subflow::solver {
 
 struct StereoRefinementOptions;
+class ViewCache;
 
 // The images of the frames a window needs, smoothed (σ = image_sigma) and the silhouettes'
 // signed distances, each computed once and released when no later window needs them.
@@ -82,6 +83,9 @@ struct RefinementWindow {
   std::vector<char> active_faces;     // #F(ℓ): refined at this level (adaptivity)
   std::vector<char> active_vertices;  // #V(ℓ): corners of active faces
   std::map<int, FrameState> states;   // frames max(0, first − 1) … min(frame_count − 1, last + 1)
+  // Where the correlation blocks' views are sampled once per evaluation point (the
+  // problem's evaluation callback, view_cache.h); null: each block samples its own.
+  ViewCache* views = nullptr;
 
   double* Increment(int frame, int vertex) {
     return states.at(frame).increments.data() + static_cast<std::ptrdiff_t>(vertex) * dof;

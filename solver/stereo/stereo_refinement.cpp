@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/stopwatch.h"
 #include "geometry/multires_shape.h"
+#include "solver/stereo/patch_levels.h"
 #include "solver/stereo/refinement_window.h"
 #include "solver/stereo/window_solve.h"
 
@@ -33,38 +34,6 @@ std::vector<std::pair<int, int>> Windows(int frames, int window, int overlap) {
   }
   return windows;
 }
-
-// The finest level whose faces' median largest projected area (over the cameras facing
-// them) is at least `min_area` pixels²; level 0 when none is. Areas shrink 4× per level.
-int AutomaticFinestLevel(const LoopHierarchy& hierarchy, const Positions& finest_control,
-                         const std::vector<vision::Camera>& cameras, double min_area) {
-  const Positions base = geometry::MultiresShape::Analyze(hierarchy, finest_control).base();
-  const Positions corners = hierarchy.LimitPositions(0) * base;
-  const geometry::Faces& F = hierarchy.LevelFaces(0);
-  std::vector<double> areas;
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d X0 = corners.row(F(f, 0)), X1 = corners.row(F(f, 1)), X2 = corners.row(F(f, 2));
-    const Eigen::Vector3d normal = (X1 - X0).cross(X2 - X0);
-    double largest = 0.0;
-    for (const vision::Camera& camera : cameras) {
-      if (normal.dot(camera.Center() - (X0 + X1 + X2) / 3.0) <= 0.0) continue;
-      const Eigen::Vector2d a = camera.ProjectUndistorted(X1) - camera.ProjectUndistorted(X0);
-      const Eigen::Vector2d b = camera.ProjectUndistorted(X2) - camera.ProjectUndistorted(X0);
-      largest = std::max(largest, 0.5 * std::abs(a.x() * b.y() - a.y() * b.x()));
-    }
-    if (largest > 0.0) areas.push_back(largest);
-  }
-  if (areas.empty()) return 0;
-  std::nth_element(areas.begin(), areas.begin() + areas.size() / 2, areas.end());
-  double area = areas[areas.size() / 2];
-  int level = 0;
-  while (level < hierarchy.finest_level() && area / 4.0 >= min_area) {
-    area /= 4.0;
-    ++level;
-  }
-  return level;
-}
-
 
 // The refinement state of the whole sequence, which the windows' solutions move.
 struct SequenceState {
@@ -248,10 +217,9 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
       ThrowError("stereo refinement", "control[" + std::to_string(f) + "]",
                  "must have #V(finest) = " + std::to_string(hierarchy.VertexCount(hierarchy.finest_level())) +
                      " finite rows");
-  const int finest_refined =
-      options.finest_level >= 0
-          ? options.finest_level
-          : AutomaticFinestLevel(hierarchy, control[control.size() / 2], images.cameras, options.min_patch_area);
+  const PatchLevels patch_levels(hierarchy, control[control.size() / 2], images.cameras, options.min_patch_area,
+                                 options.per_patch_levels && options.finest_level < 0);
+  const int finest_refined = options.finest_level >= 0 ? options.finest_level : patch_levels.finest_level();
   if (finest_refined > hierarchy.finest_level() || options.coarsest_level > finest_refined)
     ThrowError("stereo refinement options", "coarsest_level/finest_level",
                "must satisfy coarsest ≤ finest ≤ " + std::to_string(hierarchy.finest_level()));
@@ -274,14 +242,19 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
                                                 progress, &done);
     if (level == finest_refined) break;
     // Adaptivity: a child face is refined when its parent was and one of the parent's
-    // corners moved by more than the threshold at this level.
+    // corners moved by more than the threshold at this level (details not small), and,
+    // below the median level, when it still covers min_patch_area (patch_levels.h).
     const geometry::Faces& F = hierarchy.LevelFaces(level);
     std::vector<char> next(hierarchy.FaceCount(level + 1), 0);
     for (int f = 0; f < hierarchy.FaceCount(level); ++f) {
       const bool refine = active[f] && (moved[F(f, 0)] || moved[F(f, 1)] || moved[F(f, 2)]);
-      for (int k = 0; k < 4; ++k) next[LoopHierarchy::ChildFace(f, k)] = refine ? 1 : 0;
+      for (int k = 0; k < 4; ++k) {
+        const int child = LoopHierarchy::ChildFace(f, k);
+        next[child] = refine && (options.finest_level >= 0 || patch_levels.Resolved(level + 1, child)) ? 1 : 0;
+      }
     }
     active = std::move(next);
+    if (std::find(active.begin(), active.end(), 1) == active.end()) break;  // nothing left to refine
   }
   ProgressEnd(progress);
   result.seconds = start.Seconds();

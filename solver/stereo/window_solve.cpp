@@ -5,12 +5,14 @@
 #include <memory>
 
 #include <ceres/ceres.h>
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include "core/stopwatch.h"
 #include "solver/stereo/photometric_residuals.h"
 #include "solver/stereo/regularization_residuals.h"
 #include "solver/stereo/stereo_refinement.h"
+#include "solver/stereo/view_cache.h"
 
 namespace subflow::solver {
 namespace {
@@ -18,6 +20,7 @@ namespace {
 // Per frame of the sequence: the sum and count of the figures of `records` at the current
 // parameters — per stereo pair NCC ≈ 1 − ‖r_pair‖² / (2 W) (exact for ε = 0), per
 // silhouette block the squared outline distance in pixels.
+// The views must have been sampled at the current parameters (ViewCache).
 void Evaluate(ceres::Problem& problem, const std::vector<ResidualRecord>& records, bool ncc,
               double silhouette_weight, int frames, std::vector<double>* sum, std::vector<int>* count) {
   sum->assign(frames, 0.0);
@@ -26,7 +29,7 @@ void Evaluate(ceres::Problem& problem, const std::vector<ResidualRecord>& record
   for (const ResidualRecord& record : records) {
     double cost = 0.0;
     r.resize(problem.GetCostFunctionForResidualBlock(record.id)->num_residuals());
-    problem.EvaluateResidualBlock(record.id, false, &cost, r.data(), nullptr);
+    problem.EvaluateResidualBlockAssumingParametersUnchanged(record.id, false, &cost, r.data(), nullptr);
     if (ncc) {
       int offset = 0;
       for (const CorrelationPair& pair : record.correlation->pairs()) {
@@ -72,8 +75,12 @@ void BuildResiduals(RefinementWindow& window, ceres::LossFunction* ncc_loss, cer
 
 WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bounds) {
   const StereoRefinementOptions& options = *window.options;
+  ViewCache views(window.states.begin()->first, static_cast<int>(window.states.size()),
+                  static_cast<int>(window.cameras->size()), static_cast<int>(window.active_faces.size()), window.dof);
+  window.views = &views;
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.evaluation_callback = &views;
   ceres::Problem problem(problem_options);
   std::unique_ptr<ceres::LossFunction> ncc_loss;
   if (options.ncc_loss_scale > 0) ncc_loss = std::make_unique<ceres::CauchyLoss>(options.ncc_loss_scale);
@@ -89,6 +96,7 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
   const int frames = window.frame_count;
   std::vector<double> ncc_before, silhouette_before, ncc_after, silhouette_after;
   std::vector<int> ncc_count, silhouette_count;
+  views.PrepareForEvaluation(false, true);
   Evaluate(problem, stereo, true, options.silhouette_weight, frames, &ncc_before, &ncc_count);
   Evaluate(problem, silhouette, false, options.silhouette_weight, frames, &silhouette_before, &silhouette_count);
   if (problem.NumParameterBlocks() > 0 && problem.NumResidualBlocks() > 0) {
@@ -97,13 +105,19 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
     ceres::Solve(options.solver.ToCeres(), &problem, &summary);
     solution.solver_seconds = solve_start.Seconds();
     solution.iterations = static_cast<int>(summary.iterations.size());
-    spdlog::debug("refinement level {} frames {}–{}: {}; jacobians {:.2f} s, residuals {:.2f} s, "
-                  "linear solver {:.2f} s", window.level, window.first, window.last, summary.BriefReport(),
-                  summary.jacobian_evaluation_time_in_seconds, summary.residual_evaluation_time_in_seconds,
-                  summary.linear_solver_time_in_seconds);
+    std::string costs;
+    for (const ceres::IterationSummary& iteration : summary.iterations)
+      costs += fmt::format("{}{:.4g}{}", costs.empty() ? "" : " ", iteration.cost, iteration.step_is_successful ? "" : "✗");
+    spdlog::debug("refinement level {} frames {}–{}: {} residuals in {} blocks, {} views; {}; jacobians {:.2f} s, "
+                  "residuals {:.2f} s, linear solver {:.2f} s; cost per iteration {}", window.level, window.first,
+                  window.last, problem.NumResiduals(), problem.NumResidualBlocks(), views.size(),
+                  summary.BriefReport(), summary.jacobian_evaluation_time_in_seconds,
+                  summary.residual_evaluation_time_in_seconds, summary.linear_solver_time_in_seconds, costs);
   }
+  views.PrepareForEvaluation(false, true);  // at the solution Ceres wrote back
   Evaluate(problem, stereo, true, options.silhouette_weight, frames, &ncc_after, &ncc_count);
   Evaluate(problem, silhouette, false, options.silhouette_weight, frames, &silhouette_after, &silhouette_count);
+  window.views = nullptr;
 
   const int vertices = static_cast<int>(window.active_vertices.size());
   for (int t = window.first; t <= window.last; ++t) {

@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "output/options_json.h"
+#include "tests/cli/sphere_dataset.h"
 #include "tests/test_support.h"
-#include "vision/synthetic_render.h"
 
 namespace subflow {
 namespace {
@@ -23,20 +23,9 @@ const test::TemporaryDirectory& Scratch() {
   return scratch;
 }
 
-// A sphere seen by a ring of 5 cameras at 96×72 pixels, 3 frames (~25³ voxels): seconds.
+// tests/cli/sphere_dataset.h, written once per run.
 const fs::path& SphereDataset() {
-  static const fs::path directory = [] {
-    const fs::path path = Scratch().FreshPath("sphere");
-    vision::SynthOptions options;
-    options.scene.scene = "sphere";
-    options.scene.frame_count = 3;
-    options.scene.subdivisions = 4;
-    options.rig.camera_count = 5;
-    options.rig.width = 96;
-    options.rig.height = 72;
-    vision::WriteSyntheticDataset(path.string(), options);
-    return path;
-  }();
+  static const fs::path directory = test::WriteSphereDataset(Scratch() / "sphere");
   return directory;
 }
 

@@ -223,6 +223,40 @@ TEST(RenderCommand, WithoutDatasetDrawsTheTurntableOnly) {
   EXPECT_FALSE(fs::exists(out / "overlay"));
 }
 
+// eval --error-maps writes result folders whose vertex properties render --colour-by
+// pictures: here the view counts of the true surface (the result is the truth, so its
+// errors are 0).
+TEST(RenderCommand, ColoursByAVertexPropertyOfTheErrorMaps) {
+  const fs::path maps = Scratch().FreshPath("maps");
+  const test::CommandResult eval =
+      RunSubflow("eval " + Quote(Dataset()) + " " + Quote(Result()) + " --error-maps " + Quote(maps), Scratch().path());
+  ASSERT_EQ(eval.exit_code, 0) << eval.output();
+  geometry::VertexProperties properties;
+  geometry::ReadMesh((maps / "truth" / "meshes" / "000001.ply").string(), {}, &properties);
+  ASSERT_TRUE(properties.values.count("views") && properties.values.count("error"));
+  EXPECT_LT(properties.values["error"].cwiseAbs().maxCoeff(), 1e-6);
+  const double most_views = properties.values["views"].maxCoeff();
+  EXPECT_GE(most_views, 2.0);
+  EXPECT_LE(most_views, 4.0);
+
+  const fs::path out = Scratch().FreshPath("views");
+  const test::CommandResult run = RunSubflow("render " + Quote(maps / "truth") + " --out " + Quote(out) +
+                                                 " --colour-by views --no-textured --no-overlays --views 0",
+                                             Scratch().path());
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  const nlohmann::json report = nlohmann::json::parse(test::ReadTextFile(out / "report.json"));
+  ASSERT_TRUE(report["colour_scales"].contains("views"));
+  EXPECT_FALSE(report["colour_scales"].contains("flow"));
+  EXPECT_GE(report["colour_scales"]["views"]["max"].get<double>(), most_views);
+  EXPECT_TRUE(fs::exists(out / "views" / vision::Dataset(Dataset().string()).camera(0).name() / "000001.png"));
+
+  const test::CommandResult missing = RunSubflow("render " + Quote(maps / "truth") + " --out " +
+                                                     Quote(Scratch().FreshPath("missing")) + " --colour-by nosuch",
+                                                 Scratch().path());
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("vertex property nosuch"), std::string::npos) << missing.output();
+}
+
 TEST(RenderCommand, RefusesFramesOutsideTheResultAndExistingOutput) {
   const test::CommandResult bad = RunSubflow(
       "render " + Quote(Result()) + " --out " + Quote(Scratch().FreshPath("bad")) + " --frames 7", Scratch().path());

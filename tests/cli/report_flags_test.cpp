@@ -11,8 +11,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/cli/sphere_dataset.h"
 #include "tests/test_support.h"
-#include "vision/synthetic_render.h"
 
 namespace subflow {
 namespace {
@@ -24,20 +24,9 @@ const test::TemporaryDirectory& Scratch() {
   return scratch;
 }
 
-// A sphere seen by a ring of 5 cameras at 96×72 pixels, 3 frames, with backgrounds.
+// tests/cli/sphere_dataset.h, written once per run.
 const fs::path& SphereDataset() {
-  static const fs::path directory = [] {
-    const fs::path path = Scratch().FreshPath("sphere");
-    vision::SynthOptions options;
-    options.scene.scene = "sphere";
-    options.scene.frame_count = 3;
-    options.scene.subdivisions = 4;
-    options.rig.camera_count = 5;
-    options.rig.width = 96;
-    options.rig.height = 72;
-    vision::WriteSyntheticDataset(path.string(), options);
-    return path;
-  }();
+  static const fs::path directory = test::WriteSphereDataset(Scratch() / "sphere");
   return directory;
 }
 
@@ -71,6 +60,9 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--evidence", {"background", "/options/shape_init/silhouettes/source", "background"}},
       {"--levels", {"1", "/options/shape_init/levels", 1}},
       {"--base-faces", {"60", "/options/shape_init/simplify/target_face_count", 60}},
+      // --base-faces selects the count mode: the distance bound given too is set to 0.
+      {"--base-distance", {"1.5", "/options/shape_init/base_distance_voxels", 0.0}},
+      {"--finest-edge-pixels", {"1.5", "/options/shape_init/finest_edge_pixels", 1.5}},
       {"--reference-frame", {"2", "/options/shape_init/reference_frame", 2}},
       {"--first-frame", {"1", "/options/shape_init/first_frame", 1}},
       {"--frames", {"2", "/options/shape_init/frame_count", 2}},
@@ -93,6 +85,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--window-overlap", {"1", "/options/refinement/window_overlap", 1}},
       {"--rounds", {"2", "/options/refinement/rounds", 2}},
       {"--iterations", {"3", "/options/refinement/solver/max_iterations", 3}},
+      {"--function-tolerance", {"0.01", "/options/refinement/solver/function_tolerance", 0.01}},
       {"--linear-solver", {"DENSE_QR", "/options/refinement/solver/linear_solver", "dense_qr"}},
       {"--threads", {"1", "/options/refinement/solver/threads", 1}},
       {"--samples-per-pixel", {"0.5", "/options/refinement/samples_per_pixel", 0.5}},

@@ -75,6 +75,45 @@ TEST(ClosestPoint, IcosphereQueriesAgreeWithTheSphere) {
   EXPECT_EQ(tree.Side(Eigen::Vector3d(5, 0, 0)), PointSide::kOutside);
 }
 
+// A bounded cast stops at the first box beyond the bound instead of walking the whole
+// ray: every hit within the bound must be exactly (point, face, t) the unbounded cast's,
+// and none beyond it may be reported. Rays from points near and far from a bumpy sphere in
+// random directions, bounds from a tenth of an edge to the diameter.
+TEST(ClosestPoint, BoundedRayCastsFindExactlyTheHitsOfUnboundedOnes) {
+  TriangleMesh bumpy = MakeIcosphere(4, 1.0);
+  for (Eigen::Index v = 0; v < bumpy.V.rows(); ++v) {
+    const Eigen::Vector3d p = bumpy.V.row(v);
+    bumpy.V.row(v) *= 1.0 + 0.15 * std::sin(5 * p.x()) * std::cos(4 * p.y() + p.z());
+  }
+  const ClosestPointTree tree(bumpy);
+  std::mt19937 generator(11);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> radius(0.5, 1.6);
+  int hits = 0, compared = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Eigen::Vector3d origin =
+        radius(generator) * Eigen::Vector3d(normal(generator), normal(generator), normal(generator)).normalized();
+    const Eigen::Vector3d direction(normal(generator), normal(generator), normal(generator));
+    const RayHit line = tree.NearestHitOnLine(origin, direction);
+    const RayHit ray = tree.FirstHit(origin, direction);
+    for (double bound : {0.005, 0.05, 0.3, 2.0}) {
+      const RayHit bounded_line = tree.NearestHitOnLine(origin, direction, bound);
+      const RayHit bounded_ray = tree.FirstHit(origin, direction, bound);
+      const bool line_within = line.hit && std::abs(line.t) <= bound;
+      ASSERT_EQ(bounded_line.hit, line_within) << "ray " << i << ", bound " << bound << ", t " << line.t;
+      ASSERT_EQ(bounded_ray.hit, ray.hit && ray.t <= bound) << i << " " << bound;
+      if (line_within) {
+        EXPECT_EQ(bounded_line.t, line.t);
+        EXPECT_EQ(bounded_line.face, line.face);
+        EXPECT_EQ(bounded_line.point, line.point);
+        ++hits;
+      }
+      ++compared;
+    }
+  }
+  EXPECT_GT(hits, compared / 4);
+}
+
 TEST(ClosestPoint, DegenerateFacesAreSkippedAndBadIndicesRejected) {
   TriangleMesh mesh = MakeIcosphere(1, 1.0);
   mesh.F.conservativeResize(mesh.F.rows() + 1, 3);

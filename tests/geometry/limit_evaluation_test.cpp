@@ -88,17 +88,6 @@ Eigen::RowVector3d LimitMask(const TriangleMesh& mesh, const MeshTopology& topol
   return s;
 }
 
-// Limit normal at an interior vertex from the tangent masks Σ cos/sin(2πk/K) r_k.
-Eigen::RowVector3d TangentMaskNormal(const TriangleMesh& mesh, const MeshTopology& topology, int w) {
-  Eigen::RowVector3d t1 = Eigen::RowVector3d::Zero(), t2 = Eigen::RowVector3d::Zero();
-  const IndexRange ring = topology.Ring(w);
-  for (int k = 0; k < ring.size(); ++k) {
-    t1 += std::cos(2 * kPi * k / ring.size()) * mesh.V.row(ring[k]);
-    t2 += std::sin(2 * kPi * k / ring.size()) * mesh.V.row(ring[k]);
-  }
-  return t1.cross(t2).normalized();
-}
-
 // Vertex of levels[start + depth] at the dyadic point (i, j)/2^depth of face `face` of
 // levels[start], for all i + j ≤ 2^depth.
 std::map<std::pair<int, int>, int> DyadicVertices(const std::vector<TriangleMesh>& levels,

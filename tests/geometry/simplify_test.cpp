@@ -246,6 +246,67 @@ TEST(SimplifyMesh, MeshAtOrBelowTargetIsReturnedUnchanged) {
   EXPECT_EQ(result.F, tetrahedron.F);
 }
 
+// A ball (radius 14 voxels) with a plate 2 voxels thick standing 12 voxels off its side:
+// the thin part of a head's ear.
+TriangleMesh BallWithThinPlate() {
+  return IsosurfaceOf([](const Eigen::Vector3d& p) {
+    return p.norm() < 14.0 || (std::abs(p.x()) < 1.0 && p.y() > 0.0 && p.y() < 26.0 && std::abs(p.z()) < 9.0);
+  });
+}
+
+// The largest distance from the input's vertices to `base` (input → result).
+double LargestDistanceFromInput(const TriangleMesh& input, const TriangleMesh& base) {
+  const SurfaceMesh mesh = ToSurfaceMesh(base);
+  const Tree tree(faces(mesh).first, faces(mesh).second, mesh);
+  double largest = 0.0;
+  for (int v = 0; v < input.vertex_count(); ++v)
+    largest = std::max(largest, std::sqrt(tree.squared_distance(Point(input.V(v, 0), input.V(v, 1), input.V(v, 2)))));
+  return largest;
+}
+
+TEST(SimplifyMesh, DistanceBoundKeepsAThinPlateThatTheFaceCountLoses) {
+  const TriangleMesh input = BallWithThinPlate();
+  SimplifyOptions options;
+  options.max_distance = 0.5 * kSpacing;  // a quarter of the plate's thickness
+  SimplifySummary bounded_summary;
+  const TriangleMesh bounded = SimplifyMesh(input, options, &bounded_summary);
+  const MeshTopology topology(bounded.F, bounded.vertex_count());
+  EXPECT_TRUE(topology.IsClosed());
+  EXPECT_EQ(topology.ComponentCount(), 1);
+  EXPECT_FALSE(SelfIntersects(bounded));
+  EXPECT_TRUE(bounded_summary.bound_kept);
+  EXPECT_EQ(bounded_summary.bound_face_count, bounded.face_count());
+  // Far fewer faces than the input, and every input sample within the bound.
+  EXPECT_LT(bounded.face_count(), input.face_count() / 4);
+  EXPECT_LE(bounded_summary.largest_sample_distance, options.max_distance * (1 + 1e-9));
+  const double bounded_distance = LargestDistanceFromInput(input, bounded);
+  EXPECT_LE(bounded_distance, options.max_distance * (1 + 1e-9));
+  // The same face count by cost alone spends the faces evenly and erodes the plate's rim.
+  SimplifyOptions by_count;
+  by_count.target_face_count = bounded.face_count();
+  const TriangleMesh counted = SimplifyMesh(input, by_count);
+  const double counted_distance = LargestDistanceFromInput(input, counted);
+  EXPECT_GT(counted_distance, 2.0 * options.max_distance);
+  std::cout << "[ figures  ] ball with plate: " << input.face_count() << " faces → " << bounded.face_count()
+            << " with the bound (largest input distance " << bounded_distance / kSpacing
+            << " voxels), by count " << counted_distance / kSpacing << " voxels, "
+            << bounded_summary.seconds << " s\n";
+}
+
+TEST(SimplifyMesh, DistanceBoundAboveTheCapGoesOnByCount) {
+  const TriangleMesh input = BallWithThinPlate();
+  SimplifyOptions options;
+  options.max_distance = 0.05 * kSpacing;
+  options.min_face_count = 50;
+  options.max_face_count = 300;
+  SimplifySummary summary;
+  const TriangleMesh capped = SimplifyMesh(input, options, &summary);
+  EXPECT_FALSE(summary.bound_kept);
+  EXPECT_GT(summary.bound_face_count, 300);
+  EXPECT_LE(capped.face_count(), 300);
+  EXPECT_GT(summary.largest_sample_distance, options.max_distance);
+}
+
 void ExpectErrorMentioning(const TriangleMesh& mesh, const SimplifyOptions& options,
                            const std::string& words) {
   try {
@@ -273,6 +334,12 @@ TEST(SimplifyMesh, BadInputsGiveClearErrors) {
   options = SimplifyOptions();
   options.max_valence = 5;
   ExpectErrorMentioning(with_nan, options, "SimplifyOptions: max_valence");
+  options = SimplifyOptions();
+  options.max_distance = -1.0;
+  ExpectErrorMentioning(with_nan, options, "SimplifyOptions: max_distance");
+  options = SimplifyOptions();
+  options.max_face_count = options.min_face_count - 1;
+  ExpectErrorMentioning(with_nan, options, "SimplifyOptions: max_face_count");
 }
 
 }  // namespace

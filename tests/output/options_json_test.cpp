@@ -58,6 +58,11 @@ void ExpectEveryFieldRecorded(const char* name) {
 TEST(OptionsJson, EveryFieldOfEveryOptionsStructIsRecordedAndReadsBack) {
   ExpectEveryFieldRecorded<vision::SilhouetteOptions>("SilhouetteOptions");
   ExpectEveryFieldRecorded<vision::VoxelCarvingOptions>("VoxelCarvingOptions");
+  ExpectEveryFieldRecorded<vision::StandingEvidenceOptions>("StandingEvidenceOptions");
+  ExpectEveryFieldRecorded<vision::PlaneSweepOptions>("PlaneSweepOptions");
+  ExpectEveryFieldRecorded<vision::DepthFusionOptions>("DepthFusionOptions");
+  ExpectEveryFieldRecorded<vision::SupportPlaneOptions>("SupportPlaneOptions");
+  ExpectEveryFieldRecorded<vision::StillEvidenceOptions>("StillEvidenceOptions");
   ExpectEveryFieldRecorded<geometry::IsosurfaceOptions>("IsosurfaceOptions");
   ExpectEveryFieldRecorded<geometry::SimplifyOptions>("SimplifyOptions");
   ExpectEveryFieldRecorded<solver::HierarchyFitOptions>("HierarchyFitOptions");

@@ -23,6 +23,10 @@ StereoRefinementOptions TestOptions() {
   options.window = 2;
   options.rounds = 1;
   options.solver.max_iterations = 10;
+  // Noise-free images: the cost keeps falling after the first iterations, so the tests
+  // claim what the solve reaches when run nearly to convergence (the default, 3e-3, stops
+  // where real images stop paying: PerturbedShape… then recovers 49.6 % instead of > 50 %).
+  options.solver.function_tolerance = 1e-4;
   return options;
 }
 

@@ -180,6 +180,16 @@ TEST(EasyMocapImport, IntriExtriYmlProjectLikeCv2ProjectPoints) {
   broken.replace(broken.find("K_02"), 4, "K_2x");
   EXPECT_NE(test::ErrorOf([&] { ParseEasyMocapCalibration(broken, extri, "intri.yml", "extri.yml"); }).find("intri.yml: K_02"),
             std::string::npos);
+  // A top level that is not a map: OpenCV's lookups throw cv::Exception (found by the
+  // calibration fuzzer); the reader names the file and the key instead.
+  // Absurd sizes are refused before OpenCV allocates them (a fuzzer's 51 GB K).
+  std::string huge = intri;
+  huge.replace(huge.find("rows: 3"), 7, "rows: 300000000");
+  EXPECT_NE(test::ErrorOf([&] { ParseEasyMocapCalibration(huge, extri, "intri.yml", "extri.yml"); }).find("rows and cols in 1..64"),
+            std::string::npos);
+  const std::string sequence = "%YAML:1.0\n---\n- 1\n- 2\n";
+  EXPECT_NE(test::ErrorOf([&] { ParseEasyMocapCalibration(sequence, extri, "intri.yml", "extri.yml"); }).find("intri.yml"),
+            std::string::npos);
 }
 
 // panutils.projectPoints, with its in-place update of x before y is distorted.
