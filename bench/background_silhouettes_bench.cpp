@@ -57,7 +57,6 @@ SilhouetteOptions OptionsOf(Variant variant) {
   options.source = EvidenceSource::kBackground;
   options.background_shadow_test = variant == kShadowTest || variant == kBoth;
   if (variant == kPlain || variant == kShadowTest) options.min_background_fraction = 1.0;  // never enough
-  if (std::getenv("CLOSE")) options.close_radius = std::atoi(std::getenv("CLOSE"));
   return options;
 }
 

@@ -141,8 +141,7 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
   tbb::parallel_for(0, camera_count, [&](int c) {
     if (sources[c] == EvidenceSource::kMotion && options.source == EvidenceSource::kAuto && estimated != nullptr &&
         c < static_cast<int>(estimated->size()) && (*estimated)[c].valid()) {
-      silhouettes[c] = SilhouetteFromEstimatedBackground(evidence.Image(c, frame), (*estimated)[c], options,
-                                                         evidence.SurelyBackground(c, options));
+      silhouettes[c] = SilhouetteFromEstimatedBackground(evidence.Image(c, frame), (*estimated)[c], options);
       return;
     }
     switch (sources[c]) {

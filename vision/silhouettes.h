@@ -279,12 +279,11 @@ struct EstimatedBackground {
 EstimatedBackground EstimateBackground(const std::vector<cv::Mat>& images,
                                        const std::vector<cv::Mat>& gray_frames,
                                        const SilhouetteOptions& options = {});
-// Silhouette from the difference of `image` to an estimated background: as
-// SilhouetteFromBackground, with the difference of unknown pixels set to 1 (object).
-// Source kBackground.
+// Silhouette from the difference of `image` to an estimated background: the plain
+// difference (no shadow test) with the histogram threshold, the difference of unknown
+// pixels set to 1 (object). Source kBackground.
 Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const EstimatedBackground& background,
-                                             const SilhouetteOptions& options = {},
-                                             const cv::Mat& surely_background = cv::Mat());
+                                             const SilhouetteOptions& options = {});
 
 // Thresholds a CV_32FC1 measure (v > threshold → object) and cleans the result: opening
 // of radius open_radius, closing of radius options.close_radius (disks), regions under
