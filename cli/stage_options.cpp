@@ -94,8 +94,16 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
   sub->add_option("--motion-threshold", o->silhouettes.motion_threshold,
                   "Threshold of the motion evidence (< 0 = automatic, Otsu)")->capture_default_str();
   sub->add_option("--background-threshold", o->silhouettes.background_threshold,
-                  "Threshold of the background difference, below 1 (< 0 = automatic, triangle)")
+                  "Threshold of the background difference, below 1 (< 0 = automatic: per camera from the noise "
+                  "outside the working volume, else triangle)")
       ->capture_default_str()->check(CLI::Range(-1e9, 0.999999));
+  sub->add_option("--background-noise-factor", o->silhouettes.background_noise_factor,
+                  "Automatic background threshold: the camera's median difference outside the working volume "
+                  "plus this many robust sigmas, in (0, 100]")
+      ->capture_default_str()->check(CLI::Range(1e-6, 100.0));
+  sub->add_flag("!--no-shadow-test", o->silhouettes.background_shadow_test,
+                "Background difference without the shadow test (a darkening that keeps the background's "
+                "texture then counts as object)");
 }
 
 void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o) {

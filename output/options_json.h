@@ -72,7 +72,9 @@ inline void from_json(const nlohmann::json& json, ThresholdMethod& method) {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SilhouetteOptions, source, background_blur_sigma, background_threshold,
                                    background_method, background_open_radius, background_min_threshold,
-                                   background_contour_fraction, motion_sigma, motion_lambda, motion_window,
+                                   background_contour_fraction, background_shadow_test, shadow_min_gain,
+                                   shadow_max_gain, shadow_window_radius, background_noise_factor,
+                                   working_volume_margin, min_background_fraction, motion_sigma, motion_lambda, motion_window,
                                    motion_threshold, motion_method, motion_min_threshold, estimate_background,
                                    background_estimate_min_frames, background_estimate_margin, close_radius,
                                    fill_holes, min_region_pixels, min_object_pixels)

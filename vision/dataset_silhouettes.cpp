@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "vision/dataset.h"
 #include "vision/silhouettes.h"
+#include "vision/silhouettes_background.h"
 #include "vision/voxel_carving.h"
 #include "vision/working_scale.h"
 
@@ -57,8 +58,14 @@ struct EvidenceImages {
   cv::Mat Mask(int camera, int frame) const { return Fit(camera, dataset.Mask(camera, frame), true); }
   cv::Mat Background(int camera) const { return Fit(camera, dataset.Background(camera)); }
   cv::Mat BackgroundGray(int camera) const { return Fit(camera, dataset.BackgroundGray(camera)); }
-  int Width(int camera) const { return working ? (*working)[camera].width() : dataset.camera(camera).width(); }
-  int Height(int camera) const { return working ? (*working)[camera].height() : dataset.camera(camera).height(); }
+  const Camera& CameraAt(int camera) const { return working ? (*working)[camera] : dataset.camera(camera); }
+  int Width(int camera) const { return CameraAt(camera).width(); }
+  int Height(int camera) const { return CameraAt(camera).height(); }
+  // The pixels that cannot show the object (outside the projected working volume).
+  cv::Mat SurelyBackground(int camera, const SilhouetteOptions& options) const {
+    const Camera& view = CameraAt(camera);
+    return OutsideWorkingVolume(view, dataset.bounds(), options.working_volume_margin * std::hypot(view.width(), view.height()));
+  }
 };
 
 void CheckWorkingCameras(const Dataset& dataset, const std::vector<Camera>* working) {
@@ -149,7 +156,7 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
             image = evidence.Gray(c, frame);
             background = evidence.BackgroundGray(c);
           }
-          silhouettes[c] = SilhouetteFromBackground(image, background, options);
+          silhouettes[c] = SilhouetteFromBackground(image, background, options, evidence.SurelyBackground(c, options));
         }
         break;
       default: {

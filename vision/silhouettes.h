@@ -105,6 +105,30 @@ struct SilhouetteOptions {
   // object; 0.35 balances the missed and the extra pixels there (each 0.3–0.9 %, IoU
   // 0.98–0.99 on the same data). 0 = off.
   double background_contour_fraction = 0.35;
+  // Shadow-robust comparison (vision/silhouettes_background.h): a pixel that one gain in
+  // [shadow_min_gain, shadow_max_gain] of the background explains, together with the
+  // texture of a (2·shadow_window_radius + 1)² window around it, is background (a soft
+  // shadow, a change of exposure). false = the plain colour difference d.
+  bool background_shadow_test = true;
+  // Darkest shadow, as a gain on linear radiance: a shadow keeps at least this fraction of
+  // the light (ambient and fill light reach into it). Lower = deeper shadows taken for
+  // background, and dark objects over the background's texture with them.
+  double shadow_min_gain = 0.2;
+  // Brightest "shadow": > 1 admits an exposure or lighting change that brightens.
+  double shadow_max_gain = 1.1;
+  // Half-size (pixels) of the window whose texture one gain must explain: larger windows
+  // hold more texture (a surer test), smaller ones follow a penumbra's gradient better.
+  int shadow_window_radius = 2;
+  // Per-camera threshold: median + this many robust σ (1.4826 MAD) of the difference
+  // over the pixels outside the projected working volume (never below
+  // background_min_threshold). Used when background_threshold < 0 and at least
+  // min_background_fraction of the image is outside; else background_method.
+  double background_noise_factor = 6.0;
+  // Margin (pixels, as a fraction of the image's diagonal) around the working volume's
+  // projection within which a pixel is not taken as surely background.
+  double working_volume_margin = 0.02;
+  // Fewest surely-background pixels (fraction of the image) for a per-camera threshold.
+  double min_background_fraction = 0.02;
 
   // --- motion evidence (eq. 23) ---
   // σ (pixels) of the spatial Gaussian smoothing before the derivatives.
@@ -199,13 +223,20 @@ double TriangleThreshold(const cv::Mat& values);
 // Silhouette from a given mask (CV_8UC1, non-zero = object). No cleaning.
 Silhouette SilhouetteFromMask(const cv::Mat& mask, const SilhouetteOptions& options = {});
 
+// CV_32F in [0, 1] with the same channels (CV_8U, CV_16U or CV_32F in; 4 channels lose alpha).
+cv::Mat ToUnitFloat(const cv::Mat& image);
+
 // Per-pixel distance d of an image to the background (same size and type; CV_8U,
 // CV_16U or CV_32F in [0, 1]; 1, 3 or 4 channels, alpha ignored), CV_32FC1 in [0, 1],
 // not yet blurred.
 cv::Mat BackgroundDifference(const cv::Mat& image, const cv::Mat& background);
-// Silhouette from the background difference (see the file comment).
+// Silhouette from the background difference (see the file comment), with the
+// shadow-robust comparison and the per-camera threshold of vision/silhouettes_background.h.
+// `surely_background`: CV_8UC1, 255 at pixels that cannot show the object
+// (OutsideWorkingVolume), for the per-camera threshold; empty = none known.
 Silhouette SilhouetteFromBackground(const cv::Mat& image, const cv::Mat& background,
-                                    const SilhouetteOptions& options = {});
+                                    const SilhouetteOptions& options = {},
+                                    const cv::Mat& surely_background = cv::Mat());
 
 // The contour of a silhouette moved to where a straight edge is half covered: pixels of
 // `mask` within 2 pixels of its contour are removed when measure(p) < fraction × the mean
@@ -248,9 +279,9 @@ struct EstimatedBackground {
 EstimatedBackground EstimateBackground(const std::vector<cv::Mat>& images,
                                        const std::vector<cv::Mat>& gray_frames,
                                        const SilhouetteOptions& options = {});
-// Silhouette from the difference of `image` to an estimated background: as
-// SilhouetteFromBackground, with the difference of unknown pixels set to 1 (object).
-// Source kBackground.
+// Silhouette from the difference of `image` to an estimated background: the plain
+// difference (no shadow test) with the histogram threshold, the difference of unknown
+// pixels set to 1 (object). Source kBackground.
 Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const EstimatedBackground& background,
                                              const SilhouetteOptions& options = {});
 

@@ -465,17 +465,38 @@ TEST(VoxelCarvingBlob, FromMasksContainsTheObject) {
   EXPECT_GT(figures.mask_iou, 0.88);
 }
 
-// Background differences, with their contour moved to half coverage, match the masks to
-// about half a pixel: the strict hull (max_misses 0) from them contains the object as
-// the masks' does.
-TEST(VoxelCarvingBlob, FromBackgroundDifferenceContainsTheObject) {
-  const BlobFigures figures = CarveBlob(EvidenceSource::kBackground);
+// Plain background differences, with their contour moved to half coverage, match the
+// masks to about half a pixel: the strict hull (max_misses 0) from them contains the
+// object as the masks' does.
+SilhouetteOptions PlainDifference() {
+  SilhouetteOptions options;
+  options.background_shadow_test = false;
+  return options;
+}
+
+TEST(VoxelCarvingBlob, FromPlainBackgroundDifferenceContainsTheObject) {
+  const BlobFigures figures = CarveBlob(EvidenceSource::kBackground, PlainDifference());
   EXPECT_EQ(figures.result.max_misses, 0);
   EXPECT_GE(figures.in_voxel_fraction, 0.99);
   EXPECT_GE(figures.inside_fraction, 0.99);
   EXPECT_GT(figures.volume_ratio, 1.0);
   EXPECT_LT(figures.volume_ratio, 1.2);  // as from the masks
   EXPECT_GT(figures.mask_iou, 0.88);
+}
+
+// The default, shadow-robust difference (vision/silhouettes_background.h): its hull is
+// tighter and closer to the masks' than the plain difference's, and still holds the
+// object inside its iso-surface. Not every true vertex keeps its voxel (0.981 of them
+// against the plain difference's 0.993): where the object is darker than an untextured
+// background by about a gain, one gain explains both (the limitation the header states).
+TEST(VoxelCarvingBlob, FromShadowRobustDifferenceIsTighterAndHoldsTheObject) {
+  const BlobFigures plain = CarveBlob(EvidenceSource::kBackground, PlainDifference());
+  const BlobFigures figures = CarveBlob(EvidenceSource::kBackground);
+  EXPECT_EQ(figures.result.max_misses, 0);
+  EXPECT_GT(figures.mask_iou, plain.mask_iou);
+  EXPECT_LT(figures.volume_ratio, plain.volume_ratio);
+  EXPECT_GT(figures.volume_ratio, 1.0);
+  EXPECT_GE(figures.inside_fraction, 0.99);  // as the plain difference's
 }
 
 // Motion evidence (eq. 23) accumulated over a window of frames 0..2 at the first frame:
