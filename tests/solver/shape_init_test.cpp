@@ -125,14 +125,22 @@ double MeanExcess(const vision::Dataset& dataset, const FrameShapeInit& frame) {
 // from them): same claim (contains the sphere, Hausdorff ≤ 3 voxels), and a mean excess
 // over the sphere within 1.5 × the masks' plus a quarter voxel. The silhouettes' contours
 // are estimated, not given: a few true vertices (≤ 0.5 %) may fall just outside.
-TEST(ShapeInit, HullFromBackgroundDifferenceIsAsCloseAsTheHullFromMasks) {
+// This is the plain difference's claim (background_shadow_test off). The default,
+// shadow-robust difference does not keep it on this untextured sphere: a shaded side
+// darker than the background by about one gain reads as shadow, and 131 of 2,562 true
+// vertices fall outside its hull (mean excess 0.65 voxels against the masks' 0.71);
+// what it gains on textured floors and shadows is measured on the scenes (the note of
+// issue 12) and in VoxelCarvingBlob.FromShadowRobustDifferenceIsTighterAndHoldsTheObject.
+TEST(ShapeInit, HullFromPlainBackgroundDifferenceIsAsCloseAsTheHullFromMasks) {
   const fs::path directory = Scratch().FreshPath("background_only");
   vision::WriteSyntheticDataset(directory.string(), SphereOptions("dome", 10, 160, 120, 2));
   const vision::Dataset with_masks(directory.string());
   const ShapeInitResult from_masks = InitializeShape(with_masks, QuickOptions());
   fs::remove_all(directory / "masks");
   const vision::Dataset dataset(directory.string());
-  const ShapeInitResult result = InitializeShape(dataset, QuickOptions());
+  ShapeInitOptions plain = QuickOptions();
+  plain.silhouettes.background_shadow_test = false;
+  const ShapeInitResult result = InitializeShape(dataset, plain);
   ASSERT_EQ(result.frames.size(), 2u);
   for (int i = 0; i < 2; ++i) {
     const FrameShapeInit& frame = result.frames[i];
