@@ -44,7 +44,8 @@ nlohmann::json DatasetJson(const vision::Dataset& dataset) {
                       {"from_file", dataset.bounds_from_file()}}},
           {"has_masks", dataset.has_masks()},
           {"has_background", dataset.has_background()},
-          {"has_videos", dataset.has_videos()}};
+          {"has_videos", dataset.has_videos()},
+          {"warnings", dataset.warnings()}};
 }
 
 nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset) {
@@ -177,6 +178,7 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
   for (const solver::MotionFrameReport& f : result.frames) {
     frames.push_back({{"frame", first_frame + f.frame},
                       {"from_frame", f.from_frame < 0 ? -1 : first_frame + f.from_frame},
+                      {"identical_images", f.identical_images},
                       {"constraints", f.step.constraints},
                       {"pruned", f.step.pruned},
                       {"collinearity_pruned", f.step.collinearity_pruned},

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <spdlog/spdlog.h>
 
 #include "core/error.h"
 #include "vision/dataset_layout.h"
@@ -135,6 +136,7 @@ Dataset::Dataset(const std::string& directory, const DatasetOptions& options)
   state_->options = options;
   state_->layout = ScanDatasetLayout(directory, options.check_image_headers);
   const DatasetLayout& layout = state_->layout;
+  for (const std::string& warning : layout.warnings) spdlog::warn("{}: {}", directory, warning);
   if (layout.info.bounds) {
     state_->bounds = *layout.info.bounds;
   } else {
@@ -166,6 +168,7 @@ bool Dataset::has_videos() const { return state_->layout.videos; }
 bool Dataset::has_masks() const { return state_->layout.masks; }
 bool Dataset::has_background() const { return state_->layout.background; }
 bool Dataset::has_groundtruth() const { return state_->layout.groundtruth; }
+const std::vector<std::string>& Dataset::warnings() const { return state_->layout.warnings; }
 
 const Camera& Dataset::camera(int camera) const {
   state_->layout.CheckIndex(camera, 0);

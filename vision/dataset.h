@@ -97,6 +97,10 @@ class Dataset {
   bool has_masks() const;
   bool has_background() const;
   bool has_groundtruth() const;
+  // What the layout check found legal but worth saying (pixel formats that differ between
+  // cameras or within a camera's frames, 16-bit data); each was also logged as a warning
+  // when the dataset was opened.
+  const std::vector<std::string>& warnings() const;
 
   // Raw frame as stored (cv::imread IMREAD_UNCHANGED): CV_8U or CV_16U, 1, 3 (BGR) or 4
   // (BGRA) channels; from a video, what VideoCapture decodes (usually CV_8UC3). Size is

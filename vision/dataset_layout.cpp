@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -42,10 +43,25 @@ int FrameIndex(const std::string& file_name, const std::string& extension) {
   return std::stoi(file_name.substr(0, 6));
 }
 
-// Width and height from a PNG's IHDR chunk (the first 24 bytes).
-void CheckPngHeader(const std::string& path, const Camera& camera) {
+// A PNG's pixel format as its IHDR chunk states it.
+struct PngFormat {
+  int bit_depth = 8;
+  int colour_type = 0;  // 0 gray, 2 RGB, 3 palette, 4 gray + alpha, 6 RGBA
+  bool operator<(const PngFormat& other) const {
+    return std::tie(bit_depth, colour_type) < std::tie(other.bit_depth, other.colour_type);
+  }
+  std::string Text() const {
+    const char* kind = colour_type == 0 ? "gray" : colour_type == 3 ? "palette" : colour_type == 4 ? "gray + alpha"
+                                                                                                   : "colour";
+    return std::to_string(bit_depth) + "-bit " + kind;
+  }
+};
+
+// Width and height from a PNG's IHDR chunk (the first 26 bytes), checked against the
+// camera; returns the pixel format (bit depth, colour type) that follows them.
+PngFormat CheckPngHeader(const std::string& path, const Camera& camera) {
   std::ifstream file(path, std::ios::binary);
-  unsigned char header[24] = {};
+  unsigned char header[26] = {};
   file.read(reinterpret_cast<char*>(header), sizeof(header));
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (!file || !std::equal(kSignature, kSignature + 8, header) ||
@@ -62,6 +78,59 @@ void CheckPngHeader(const std::string& path, const Camera& camera) {
                "expected " + SizeText(camera.width(), camera.height()) + " (camera \"" +
                    camera.name() + "\" in cameras.json), got " + std::to_string(width) + "×" +
                    std::to_string(height));
+  return {header[24], header[25]};
+}
+
+// Warnings on the images' pixel formats (`formats`: per camera, the frames of each PNG
+// format): every image is read as a gray intensity in [0, 1] (Dataset::Gray), which is
+// right for any format, but a camera whose frames change format mid-take, cameras that
+// differ, and 16-bit files (often 10- or 12-bit sensor data in the low bits, which then
+// reads dark) are worth a line each.
+std::vector<std::string> PixelFormatWarnings(const DatasetLayout& layout,
+                                             const std::vector<std::map<PngFormat, std::vector<int>>>& formats) {
+  std::vector<std::string> warnings;
+  std::map<PngFormat, std::vector<std::string>> cameras_of;  // each camera by its first frame's format
+  for (std::size_t c = 0; c < formats.size(); ++c) {
+    if (formats[c].empty()) continue;
+    const std::string& name = layout.cameras[c].name();
+    if (formats[c].size() > 1) {
+      std::string list;
+      for (const auto& [format, frames] : formats[c])
+        list += (list.empty() ? "" : ", ") + format.Text() + " in " + std::to_string(frames.size()) +
+                (frames.size() == 1 ? " frame" : " frames") + " from " + FrameName(frames.front());
+      warnings.push_back("camera \"" + name + "\": its images change pixel format within the take: " + list +
+                         "; each is read as a gray intensity in [0, 1]");
+    }
+    PngFormat first;
+    int first_frame = layout.frame_count;
+    for (const auto& [format, frames] : formats[c])
+      if (frames.front() < first_frame) first = format, first_frame = frames.front();
+    cameras_of[first].push_back(name);
+  }
+  if (cameras_of.size() > 1) {
+    std::string list;
+    for (const auto& [format, names] : cameras_of) {
+      std::string joined;
+      for (const std::string& name : names) joined += (joined.empty() ? "" : ", ") + name;
+      list += (list.empty() ? "" : "; ") + format.Text() + ": " + joined;
+    }
+    warnings.push_back("cameras' images differ in pixel format (" + list +
+                       "): each is read as a gray intensity in [0, 1] (8-bit / 255, 16-bit / 65535)");
+  }
+  std::string sixteen_bit;
+  int sixteen_bit_count = 0;
+  for (std::size_t c = 0; c < formats.size(); ++c) {
+    const bool any = std::any_of(formats[c].begin(), formats[c].end(),
+                                 [](const auto& entry) { return entry.first.bit_depth == 16; });
+    if (!any) continue;
+    sixteen_bit += (sixteen_bit.empty() ? "" : ", ") + layout.cameras[c].name();
+    ++sixteen_bit_count;
+  }
+  if (sixteen_bit_count > 0)
+    warnings.push_back("16-bit images (camera" + std::string(sixteen_bit_count > 1 ? "s " : " ") + sixteen_bit +
+                       ") are read as value / 65535: data of fewer bits in the low bits (10- or 12-bit sensors) "
+                       "then reads dark, so scale such data to the full 16-bit range first");
+  return warnings;
 }
 
 // The per-camera folders <root>/<camera>/ of <frame><extension> files (images/, masks/):
@@ -322,13 +391,16 @@ DatasetLayout ScanLayout(const std::string& directory, bool check_image_headers)
   }
 
   if (check_image_headers) {
+    std::vector<std::map<PngFormat, std::vector<int>>> formats(cameras.size());  // per camera: frames per format
     for (int c = 0; c < static_cast<int>(cameras.size()); ++c) {
       for (int f = 0; f < layout.frame_count; ++f) {
-        if (!layout.videos && layout.image_extensions[c] == ".png") CheckPngHeader(layout.ImagePath(c, f), cameras[c]);
+        if (!layout.videos && layout.image_extensions[c] == ".png")
+          formats[c][CheckPngHeader(layout.ImagePath(c, f), cameras[c])].push_back(f);
         if (layout.masks) CheckPngHeader(layout.MaskPath(c, f), cameras[c]);
       }
       if (layout.background) CheckPngHeader(layout.BackgroundPath(c), cameras[c]);
     }
+    layout.warnings = PixelFormatWarnings(layout, formats);
   }
   return layout;
 }

@@ -21,6 +21,9 @@ struct DatasetLayout {
   bool videos = false, masks = false, background = false, groundtruth = false;
   std::vector<std::string> video_paths;  // per camera, when `videos`
   std::vector<std::string> image_extensions;  // per camera, when images/ (".png", ".jpg", ...)
+  // Legal but worth saying (pixel formats that differ between cameras or frames, 16-bit
+  // data), found while checking the PNG headers.
+  std::vector<std::string> warnings;
 
   std::string ImagePath(int camera, int frame) const;  // the video's path when `videos`
   std::string MaskPath(int camera, int frame) const;

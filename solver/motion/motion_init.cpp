@@ -30,6 +30,18 @@ std::string MotionInitResult::BriefReport() const {
                      seconds);
 }
 
+namespace {
+
+// Every camera's image equal, pixel for pixel (a duplicated frame).
+bool IdenticalImages(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b) {
+  for (std::size_t k = 0; k < a.size(); ++k)
+    if (a[k].size() != b[k].size() || a[k].type() != b[k].type() || cv::norm(a[k], b[k], cv::NORM_INF) != 0.0)
+      return false;
+  return !a.empty();
+}
+
+}  // namespace
+
 void MotionInitOptions::Check() const {
   step.Check();
   if (!std::isfinite(hull_weight) || hull_weight < 0.0 || hull_weight > 1.0)
@@ -102,6 +114,12 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     MotionFrameReport& report = result.frames[to];
     report.from_frame = from;
     report.step = step.report;
+    report.identical_images = IdenticalImages(from_images, to_images);
+    if (report.identical_images)
+      spdlog::warn("motion init: frame {} is identical to frame {} in every camera (a repeated frame, as capture "
+                   "software writes for a dropped one?): no image motion between them, so the surface stands "
+                   "still there and the motion of the dropped frame lands in the next step",
+                   images.first_frame + to, images.first_frame + from);
     if (const Positions* target = fitted(to); target && options.hull_weight > 0.0) {
       const geometry::ClosestPointTree tree(estimator.visibility().Tessellation(*target),
                                             "fitted surface of frame " + std::to_string(to));

@@ -42,6 +42,7 @@ struct MotionInitOptions {
 struct MotionFrameReport {
   int frame = 0;
   int from_frame = -1;  // the frame it was propagated from; −1 for the reference frame
+  bool identical_images = false;  // every camera's image equals from_frame's (a duplicated frame)
   MotionStepReport step;
   bool corrected = false;           // normal correction applied
   double correction_rms_before = 0.0;  // RMS normal distance to the frame's fitted surface

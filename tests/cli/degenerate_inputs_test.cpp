@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "geometry/mesh_io.h"
@@ -201,6 +202,35 @@ TEST(DegenerateInputs, SixteenBitImagesBesideEightBitColourAndGrayGiveTheSameHul
   // Gray values are identical up to float rounding (v / 255 vs 257 v / 65535).
   for (int f = 0; f < 3; ++f)
     EXPECT_LT((wide.frame_mesh[f].V - narrow.frame_mesh[f].V).cwiseAbs().maxCoeff(), 1e-4) << f;
+  // Both runs say how the mixed formats are read, in the log and in report.json.
+  const std::string mixed_wide =
+      "cameras' images differ in pixel format (8-bit gray: cam02, cam03, cam04; 16-bit gray: cam01; 16-bit colour: "
+      "cam00): each is read as a gray intensity in [0, 1]";
+  const std::string mixed_narrow =
+      "cameras' images differ in pixel format (8-bit gray: cam01, cam02, cam03, cam04; 8-bit colour: cam00)";
+  const std::string sixteen = "16-bit images (cameras cam00, cam01) are read as value / 65535";
+  EXPECT_NE(wide.command.output().find(mixed_wide), std::string::npos) << wide.command.output();
+  EXPECT_NE(wide.command.output().find(sixteen), std::string::npos) << wide.command.output();
+  EXPECT_NE(narrow.command.output().find(mixed_narrow), std::string::npos) << narrow.command.output();
+  EXPECT_EQ(narrow.command.output().find("16-bit images"), std::string::npos) << narrow.command.output();
+  ASSERT_EQ(wide.report["dataset"]["warnings"].size(), 2u) << wide.report["dataset"].dump();
+  EXPECT_NE(wide.report["dataset"]["warnings"][0].get<std::string>().find("differ in pixel format"), std::string::npos);
+}
+
+TEST(DegenerateInputs, ACameraWhoseFramesChangePixelFormatIsNamedInAWarning) {
+  const fs::path dataset = CopyOfBase("format_change");
+  const fs::path frame = dataset / "images" / "cam02" / "000001.png";
+  const cv::Mat gray = cv::imread(frame.string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(gray.type(), CV_8UC1);
+  cv::Mat colour;
+  cv::merge(std::vector<cv::Mat>{gray, gray, gray}, colour);
+  cv::imwrite(frame.string(), colour);
+  const HullRun run = Hull(dataset, "format_change");
+  for (int f = 0; f < 3; ++f) ExpectSphere(run, f);
+  EXPECT_NE(run.command.output().find("camera \"cam02\": its images change pixel format within the take: 8-bit "
+                                      "gray in 2 frames from 000000, 8-bit colour in 1 frame from 000001"),
+            std::string::npos)
+      << run.command.output();
 }
 
 TEST(DegenerateInputs, PolygonMeshesWithUnusedVerticesAreSubdividedAndValid) {

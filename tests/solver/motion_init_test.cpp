@@ -163,6 +163,36 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
   EXPECT_LT(mean_non_rigid, 0.2 * mean_flow);
 }
 
+// A duplicated frame (capture software repeats a frame when it drops one): frames 0, 1, 1
+// of the rigid scene as frames 0, 1, 2. The step onto the repeat is flagged and stands
+// still (no image motion: the surface moves by < 2 % of a true step); the other is not
+// flagged and moves the surface by about the true step.
+TEST(MotionInit, FlagsADuplicatedFrameAndKeepsTheSurfaceStill) {
+  const MotionTestScene& scene = Scene();
+  vision::SyntheticSceneOptions options;
+  options.scene = "rigid";
+  options.frame_count = 2;
+  options.subdivisions = 4;
+  const vision::SyntheticScene sequence = vision::MakeSyntheticScene(options);
+  const std::vector<cv::Mat> first = testing::RenderGray(scene, sequence.frames[0]);
+  const std::vector<cv::Mat> second = testing::RenderGray(scene, sequence.frames[1]);
+  const vision::ImageSequence images{scene.cameras, 0, 3, [&](int camera, int frame) {
+                                       return frame == 0 ? first[camera] : second[camera].clone();
+                                     }, {}};
+  const MotionInitResult result = InitializeMotion(images, scene.hierarchy, {scene.control}, 0, MotionInitOptions());
+  ASSERT_EQ(result.control.size(), 3u);
+  EXPECT_FALSE(result.frames[0].identical_images);  // the reference frame
+  EXPECT_FALSE(result.frames[1].identical_images);
+  EXPECT_TRUE(result.frames[2].identical_images);
+  const double true_step = (sequence.frames[1] - sequence.frames[0]).rowwise().norm().mean();
+  const double moved = (result.control[1] - result.control[0]).rowwise().norm().mean();
+  const double repeated = (result.control[2] - result.control[1]).rowwise().norm().mean();
+  std::printf("true step %.3f mm, estimated %.3f mm, onto the repeat %.4f mm\n", 1e3 * true_step, 1e3 * moved,
+              1e3 * repeated);
+  EXPECT_GT(moved, 0.5 * true_step);
+  EXPECT_LT(repeated, 0.02 * true_step);
+}
+
 TEST(MotionInit, RejectsInconsistentInputs) {
   const MotionTestScene& scene = Scene();
   const vision::ImageSequence images{scene.cameras, 0, 3, [](int, int) { return cv::Mat(); }, {}};
