@@ -53,6 +53,9 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
   sub->add_option("--finest-edge-pixels", o->finest_edge_pixels,
                   "Projected length of the finest level's edges the automatic levels aim at, in [0.25, 1000]")
       ->capture_default_str()->check(CLI::Range(0.25, 1000.0));
+  sub->add_option("--max-finest-faces", o->max_finest_faces,
+                  "Face budget of the automatic levels' finest level (motion and refinement cost grows with it)")
+      ->capture_default_str()->check(CLI::Range(4, 50000000));
   sub->add_option("--base-distance", o->base_distance_voxels,
                   "The base mesh T0 stays within this many voxels of the reference hull, both ways: the "
                   "subject's detail sets its faces (0 = by count, --base-faces)")

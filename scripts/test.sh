@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The one test command (CI runs it): installs, builds and runs every test (CTest +
-# GoogleTest) in build/ (Release); then the tests of core/, geometry/ and vision/ built with
-# ASan + UBSan in build-asan/ (scripts/sanitize.sh; SUBFLOW_SANITIZE_FOLDERS=all for every
-# test); then each reader's fuzz harness for a short fixed time (scripts/fuzz.sh,
+# GoogleTest) in build/ (Release); then every test again, built with ASan + UBSan in
+# build-asan/ (scripts/sanitize.sh; SUBFLOW_SANITIZE_FOLDERS picks test folders); then
+# each reader's fuzz harness for a short fixed time (scripts/fuzz.sh,
 # SUBFLOW_FUZZ_SECONDS, default 10). Set SUBFLOW_TEST_RELEASE_ONLY=1 to skip the last two
 # (a quick local run).
 set -euo pipefail

@@ -62,7 +62,9 @@ BaseResolution ChooseBaseResolution(const geometry::TriangleMesh& hull, const st
       // Raise T0's faces so that its typical edges project to t · 2^L (the collapses stop
       // earlier; the bound still holds).
       const double ratio = edge / (options.finest_edge_pixels * std::ldexp(1.0, result.levels));
-      const double wanted = std::min<double>(result.base.face_count() * ratio * ratio, simplify.max_face_count);
+      const double budget = static_cast<double>(options.max_finest_faces) / std::ldexp(1.0, 2 * result.levels);
+      const double wanted =
+          std::min({result.base.face_count() * ratio * ratio, static_cast<double>(simplify.max_face_count), budget});
       if (wanted > result.base.face_count() * 1.05) {
         simplify.min_face_count = static_cast<int>(std::lround(wanted));
         result.base = geometry::SimplifyMesh(hull, simplify, &result.simplify, source);
@@ -72,6 +74,10 @@ BaseResolution ChooseBaseResolution(const geometry::TriangleMesh& hull, const st
   }
   result.base_edge_pixels = MedianProjectedEdge(cameras, result.base.V, result.base.F);
   result.finest_edge_pixels = result.base_edge_pixels / std::ldexp(1.0, result.levels);
+  if (options.levels < 0 && result.finest_edge_pixels > 2 * options.finest_edge_pixels)
+    spdlog::info("base mesh T0: the finest edges project to {:.1f} px, not {:.1f}: the face budget ({} finest faces, "
+                 "--max-finest-faces) bounds the levels' cost",
+                 result.finest_edge_pixels, options.finest_edge_pixels, options.max_finest_faces);
   spdlog::info("base mesh T0: {} faces{} (edges {:.1f} px), {} levels (finest edges {:.2f} px){}",
                result.base.face_count(),
                bounded ? fmt::format(" within {:.3g} of the hull ({} faces by the bound alone, edges {:.1f} px)",

@@ -14,7 +14,8 @@
 //      (t = finest_edge_pixels, N ≥ |B|): T0's typical edges become t · 2^L, so the
 //      finest edges are about t pixels where the subject is smooth, and finer on the parts
 //      the bound kept (with a face budget of N · 4^L ≤ max_finest_faces and
-//      |T0| ≤ simplify.max_face_count).
+//      |T0| ≤ simplify.max_face_count). The budget is the cost bound: on HD images the
+//      finest edges then stay coarser than finest_edge_pixels.
 // With base_distance_voxels = 0, T0 is the count-based simplification (target_face_count
 // faces) and step 3 picks L from its edges. An explicit `levels` ≥ 0 skips steps 3–4.
 #pragma once

@@ -62,7 +62,12 @@ struct ShapeInitOptions {
   // max_finest_faces faces at the finest level.
   int levels = -1;
   double finest_edge_pixels = 2.0;
-  int max_finest_faces = 2000000;
+  // The cost bound of the automatic levels: motion initialization works on every finest
+  // vertex and refinement on every finest patch, so their time and memory grow with the
+  // finest level's faces. 65,536 is 2.6× the shared blob's 25,216 at 2 px; a 1088×1920
+  // take at 2 px wanted 600,064 (pose2sim_multiperson: 3.5 s a frame to fit, 11 GB and
+  // minutes per motion step), and now gets its finest edges at about 6 px instead.
+  int max_finest_faces = 65536;
   // Frame whose visual hull gives the base connectivity; −1 = the middle frame.
   int reference_frame = -1;
   // Frames [first_frame, first_frame + frame_count); frame_count −1 = to the end.

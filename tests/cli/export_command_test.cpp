@@ -120,7 +120,9 @@ TEST(ExportCommand, ObjAndPlySequencesKeepPositionsFacesAndProperties) {
       const geometry::TriangleMesh stored = geometry::ReadMesh((Result() / "meshes" / (vision::FrameName(f) + ".ply")).string());
       EXPECT_EQ(mesh.V, stored.V) << format << " " << f;  // float values, exactly
       EXPECT_EQ(mesh.F, stored.F) << format << " " << f;
-      if (std::string(format) == "ply") EXPECT_EQ(properties.values.count("nonrigid_vx"), 1u);
+      if (std::string(format) == "ply") {
+        EXPECT_EQ(properties.values.count("nonrigid_vx"), 1u);
+      }
     }
     EXPECT_TRUE(fs::exists(out / "report.json"));
   }

@@ -142,10 +142,12 @@ int CheckKilledRun(const KillPoint& point, const fs::path& unbroken, const fs::p
   const KilledRun resumed = RunAndKill(resume, "never printed", 1, SIGINT);
   EXPECT_EQ(resumed.exit_code, 0) << resumed.err;
   EXPECT_EQ(FilesBelow(out), complete);
-  for (const std::string& file : FilesBelow(out))
-    if (!IsReport(file))
+  for (const std::string& file : FilesBelow(out)) {
+    if (!IsReport(file)) {
       EXPECT_EQ(test::ReadTextFile(out / file), test::ReadTextFile(unbroken / file))
           << file << " of the resumed run differs from the unbroken run's";
+    }
+  }
   return static_cast<int>(left.size());
 }
 

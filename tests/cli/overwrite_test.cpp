@@ -201,12 +201,16 @@ TEST(Overwrite, EveryWritingCommandRefusesAnExistingOutputAndLeavesItUntouched) 
     EXPECT_NE(refused.err.find("--overwrite"), std::string::npos) << refused.err;
     EXPECT_EQ(refused.err.find('\n'), refused.err.size() - 1) << "not one line: " << refused.err;
     EXPECT_EQ(test::ReadTextFile(precious), "the user's data\n");
-    if (command->writes_directory) EXPECT_EQ(std::distance(fs::directory_iterator(out), {}), 1);
+    if (command->writes_directory) {
+      EXPECT_EQ(std::distance(fs::directory_iterator(out), {}), 1);
+    }
 
     if (!command->try_overwrite) continue;
     const test::CommandResult replaced = test::RunSubflow(command->arguments(out) + " --overwrite", Scratch().path());
     EXPECT_EQ(replaced.exit_code, 0) << replaced.output();
-    if (!command->writes_directory) EXPECT_NE(test::ReadTextFile(out), "the user's data\n");
+    if (!command->writes_directory) {
+      EXPECT_NE(test::ReadTextFile(out), "the user's data\n");
+    }
   }
 }
 

@@ -63,6 +63,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       // --base-faces selects the count mode: the distance bound given too is set to 0.
       {"--base-distance", {"1.5", "/options/shape_init/base_distance_voxels", 0.0}},
       {"--finest-edge-pixels", {"1.5", "/options/shape_init/finest_edge_pixels", 1.5}},
+      {"--max-finest-faces", {"20000", "/options/shape_init/max_finest_faces", 20000}},
       {"--reference-frame", {"2", "/options/shape_init/reference_frame", 2}},
       {"--first-frame", {"1", "/options/shape_init/first_frame", 1}},
       {"--frames", {"2", "/options/shape_init/frame_count", 2}},
@@ -99,9 +100,11 @@ std::map<std::string, Recorded> ReconstructFlags() {
 
 TEST(ReportFlags, EveryReconstructFlagsValueIsRecorded) {
   const std::map<std::string, Recorded> table = ReconstructFlags();
-  for (const std::string& flag : HelpFlags("reconstruct"))
-    if (flag != "--out")  // given below, recorded as "output"
+  for (const std::string& flag : HelpFlags("reconstruct")) {
+    if (flag != "--out") {  // given below, recorded as "output"
       EXPECT_EQ(table.count(flag), 1u) << flag << " is listed by --help but the test does not say where it is recorded";
+    }
+  }
 
   const fs::path out = Scratch().Subdirectory("reconstruct");
   std::string arguments = "reconstruct '" + SphereDataset().string() + "' --out '" + out.string() + "'";

@@ -284,7 +284,7 @@ TEST_F(BrokenInputs, NonFiniteHugeOrMistypedNumbersAndCutFilesAreRefusedOrHarmle
       if (!IsText(original)) continue;
       for (const auto& [start, length] : Numbers(original)) {
         const std::string number = original.substr(start, length);
-        for (const std::string& replacement : {"nan", "inf", "-inf", "1e999", "99999999999", "2147483648", "x"})
+        for (const char* replacement : {"nan", "inf", "-inf", "1e999", "99999999999", "2147483648", "x"})
           check("number \"" + number + "\" at byte " + std::to_string(start) + " → " + replacement,
                 original.substr(0, start) + replacement + original.substr(start + length));
       }

@@ -65,7 +65,9 @@ TEST(BaseResolution, FinestEdgesFollowTheImagesResolutionAndTheBaseKeepsTheBound
     EXPECT_NEAR(chosen.finest_edge_pixels, MedianProjectedEdge(cameras, chosen.base.V, chosen.base.F) /
                                                std::ldexp(1.0, chosen.levels), 1e-9);
     // Twice the pixels: one more level (the same T0 faces), not a fixed count.
-    if (previous_levels >= 0) EXPECT_EQ(chosen.levels, previous_levels + 1);
+    if (previous_levels >= 0) {
+      EXPECT_EQ(chosen.levels, previous_levels + 1);
+    }
     previous_levels = chosen.levels;
     // T0 keeps the hull within the bound both ways, the plate included.
     EXPECT_TRUE(chosen.simplify.bound_kept);
@@ -76,6 +78,31 @@ TEST(BaseResolution, FinestEdgesFollowTheImagesResolutionAndTheBaseKeepsTheBound
               << chosen.bound_face_count << " by the bound, edges " << chosen.bound_edge_pixels << " px), "
               << chosen.levels << " levels, finest edges " << chosen.finest_edge_pixels << " px\n";
   }
+}
+
+// HD images want many levels; the face budget bounds the finest level (T0's raise
+// included), keeps the levels at most those of the unbounded choice, and the finest edges
+// then project to more than the target.
+TEST(BaseResolution, TheFaceBudgetBoundsTheFinestLevelOnLargeImages) {
+  const geometry::TriangleMesh hull = BallWithPlate();
+  ShapeInitOptions unbounded;
+  unbounded.max_finest_faces = 50000000;
+  const std::vector<vision::Camera> cameras = Ring(8.0);  // 2560×1920
+  const BaseResolution wide = ChooseBaseResolution(hull, cameras, kVoxel, unbounded, "hull");
+  ShapeInitOptions budgeted = unbounded;
+  budgeted.max_finest_faces = 16384;
+  ASSERT_GT(static_cast<double>(wide.base.face_count()) * std::ldexp(1.0, 2 * wide.levels), 4.0 * 16384)
+      << "the unbounded choice must exceed the budget for this test to say anything";
+  const BaseResolution bounded = ChooseBaseResolution(hull, cameras, kVoxel, budgeted, "hull");
+  const double finest_faces = bounded.base.face_count() * std::ldexp(1.0, 2 * bounded.levels);
+  std::cout << "[ figures  ] unbounded: T0 " << wide.base.face_count() << " faces, " << wide.levels
+            << " levels; budget 16384: T0 " << bounded.base.face_count() << " faces, " << bounded.levels
+            << " levels (" << finest_faces << " finest faces, edges " << bounded.finest_edge_pixels << " px)\n";
+  EXPECT_LE(finest_faces, 16384);
+  EXPECT_GE(bounded.levels, 1);  // the budget cuts the raise of T0 before it removes levels
+  EXPECT_LE(bounded.levels, wide.levels);
+  EXPECT_GE(bounded.base.face_count(), bounded.bound_face_count);  // the distance bound still holds
+  EXPECT_GT(bounded.finest_edge_pixels, 2 * budgeted.finest_edge_pixels);
 }
 
 TEST(BaseResolution, ExplicitLevelsAndCountKeepTheOldChoice) {

@@ -37,7 +37,9 @@ TEST(ErrorMaps, ViewsCountTheCamerasThatSeeTheTruePoint) {
   const std::vector<Camera> cameras = {LookAtCamera("top", 400, 400, 800.0, {0, 0, 1.0}, {0, 0, 0})};
   const FrameErrorMaps maps = ComputeErrorMaps(truth, truth, cameras, 0.001);
   for (Eigen::Index v = 0; v < truth.V.rows(); ++v) {
-    if (truth.V(v, 2) > 0.02) EXPECT_EQ(maps.truth.views[v], 1) << v;
+    if (truth.V(v, 2) > 0.02) {
+      EXPECT_EQ(maps.truth.views[v], 1) << v;
+    }
     if (truth.V(v, 2) < -0.02) EXPECT_EQ(maps.truth.views[v], 0) << v;
     EXPECT_NEAR(maps.truth.error[v], 0.0, 1e-9);
   }
