@@ -9,6 +9,7 @@
 #include "geometry/mesh_io.h"
 #include "output/result_files.h"
 #include "output/result_writer.h"
+#include "output/stage_frames.h"
 #include "vision/dataset.h"
 
 namespace subflow::output {
@@ -29,6 +30,24 @@ geometry::TriangleMesh ReadStageMesh(const fs::path& path) {
   return geometry::ReadMesh(path.string(), options);
 }
 
+// meshes/<frame>.ply: the fitted limit surfaces with their motion to the next frame, as
+// WriteResultMeshes writes them, two frames in memory at a time rather than the take.
+void WriteFittedSurfaces(const std::string& folder, const solver::StageState& state) {
+  const geometry::Faces& faces = state.Hierarchy().LevelFaces(state.Hierarchy().finest_level());
+  std::error_code error;
+  fs::create_directories(fs::path(folder) / "meshes", error);
+  if (error) ThrowError(folder + "/meshes", "", "cannot create the directory: " + error.message());
+  geometry::Positions surface = state.Surface(0);
+  for (int i = 0; i < state.frame_count(); ++i) {
+    geometry::Positions next = i + 1 < state.frame_count() ? state.Surface(i + 1) : geometry::Positions();
+    const geometry::Positions motion = i + 1 < state.frame_count()
+                                           ? geometry::Positions(next - surface)
+                                           : geometry::Positions(geometry::Positions::Zero(surface.rows(), 3));
+    WriteResultMesh(folder, state.first_frame + i, faces, surface, motion);
+    surface = std::move(next);
+  }
+}
+
 }  // namespace
 
 void WriteStageFolder(const std::string& folder, const StageRecord& record,
@@ -45,9 +64,7 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
   WriteHullFiles(folder, state.base_mesh, state.first_frame, state.hulls, kExact);
   if (all_levels) {
     WriteControlFiles(folder, hierarchy, state.first_frame, *all_levels, kExact);
-    std::vector<geometry::Positions> surfaces;
-    for (int i = 0; i < state.frame_count(); ++i) surfaces.push_back(state.Surface(i));
-    WriteResultMeshes(folder, state.first_frame, hierarchy.LevelFaces(hierarchy.finest_level()), surfaces);
+    WriteFittedSurfaces(folder, state);
   } else {
     WriteFinestControlFiles(folder, hierarchy, state.first_frame, state.control, kExact);
   }
@@ -66,8 +83,8 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
 
 bool StageFolderComplete(const std::string& folder) { return IsFile(ReportPath(folder)); }
 
-StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage, int first_wanted,
-                            int count_wanted) {
+StageRecord ReadStageFolderHead(const std::string& folder, const std::string& expected_stage, int first_wanted,
+                                int count_wanted, int* frame_count) {
   const std::string report_path = ReportPath(folder);
   if (!IsDirectory(folder)) ThrowError(folder, "", "not a directory (expected a stage folder)");
   if (!StageFolderComplete(folder))
@@ -116,13 +133,49 @@ StageRecord ReadStageFolder(const std::string& folder, const std::string& expect
   state.base_mesh = ReadStageMesh(root / "base_mesh.ply");
   state.hierarchy = std::make_shared<const geometry::LoopHierarchy>(
       state.base_mesh.F, state.base_mesh.vertex_count(), levels, (root / "base_mesh.ply").string());
-  for (int frame = first; frame < first + count; ++frame) {
-    state.hulls.push_back(ReadStageMesh(root / "hull" / (vision::FrameName(frame) + ".ply")));
+  *frame_count = count;
+  return record;
+}
+
+geometry::TriangleMesh ReadStageHull(const std::string& folder, int frame) {
+  return ReadStageMesh(fs::path(folder) / "hull" / (vision::FrameName(frame) + ".ply"));
+}
+
+geometry::Positions ReadStageControl(const std::string& folder, int frame, const geometry::LoopHierarchy& hierarchy) {
+  const std::string path = ControlFilePath(folder, frame, hierarchy.finest_level());
+  geometry::Positions control = ReadStageMesh(path).V;
+  const Eigen::Index expected = hierarchy.VertexCount(hierarchy.finest_level());
+  if (control.rows() != expected)
+    ThrowError(path, "", std::to_string(control.rows()) + " control points, expected #V(n) = " +
+                             std::to_string(expected) + " (the base mesh's hierarchy)");
+  return control;
+}
+
+StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage, int first_wanted,
+                            int count_wanted) {
+  int count = 0;
+  StageRecord record = ReadStageFolderHead(folder, expected_stage, first_wanted, count_wanted, &count);
+  solver::StageState& state = record.state;
+  const int levels = state.Hierarchy().finest_level();
+  for (int frame = state.first_frame; frame < state.first_frame + count; ++frame) {
+    state.hulls.push_back(ReadStageHull(folder, frame));
     state.control.push_back(ReadStageMesh(ControlFilePath(folder, frame, levels)).V);
   }
   state.Check(folder);
   return record;
 }
+
+StageFolderFrames::StageFolderFrames(const std::string& folder, const std::string& expected_stage) : folder_(folder) {
+  // In the body: frame_count_'s initializer would run after head_'s and reset it.
+  head_ = ReadStageFolderHead(folder, expected_stage, 0, -1, &frame_count_);
+}
+
+geometry::Positions StageFolderFrames::Control(int i) const {
+  return ReadStageControl(folder_, first_frame() + i, Hierarchy());
+}
+
+geometry::TriangleMesh StageFolderFrames::Hull(int i) const { return ReadStageHull(folder_, first_frame() + i); }
+
 
 void SeedStageInput(StageRecord* in, const std::string& seed) {
   const nlohmann::json report = ReadJsonFile(ReportPath(seed), "a stage report (docs/stages.md)");

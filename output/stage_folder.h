@@ -52,6 +52,18 @@ bool StageFolderComplete(const std::string& folder);
 StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage = "", int first = 0,
                             int count = -1);
 
+// ReadStageFolder without the frames: the report and the state's hierarchy, base mesh,
+// first and reference frame, evidence and image scales, its hulls and control empty;
+// *frame_count gets the number of frames (of the range, with count > 0). The files of
+// frame f: StageHullPath and ControlFilePath(folder, f, levels).
+StageRecord ReadStageFolderHead(const std::string& folder, const std::string& expected_stage, int first, int count,
+                                int* frame_count);
+// A stage folder's hull/<frame>.ply, read (without the manifold check: the stage that
+// wrote it had it). Throws subflow::Error naming a missing file.
+geometry::TriangleMesh ReadStageHull(const std::string& folder, int frame);
+// A stage folder's finest control points of `frame`, checked against `hierarchy`.
+geometry::Positions ReadStageControl(const std::string& folder, int frame, const geometry::LoopHierarchy& hierarchy);
+
 // Seeds `in` (a motion or retrack stage's input) from the stage folder `seed`: the frame
 // both hold (the one nearest to seed's reference frame, when several) becomes the
 // reference frame, with seed's control points there, so that the stage's trajectories

@@ -286,7 +286,6 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
                                                                vision::FrameName(frame.frame));
     frame.control = FitHierarchyToSurface(*result.hierarchy, initial_base, hull_tree,
                                           options.fit, &frame.fit);
-    frame.shape = geometry::MultiresShape::Analyze(*result.hierarchy, frame.control.back());
     frame.fit_seconds = start.Seconds();
     ProgressUpdate(progress, ++done);
   }

@@ -10,7 +10,8 @@
 //                 → LoopHierarchy of T0 with that many levels
 //   every frame:  control points of levels 0..n fitted to H_f along limit normals
 //                 (solver/shape/hierarchy_fit.h), frames visited outwards from r so that each
-//                 starts from its neighbour's fitted base; MultiresShape by analysis.
+//                 starts from its neighbour's fitted base (the multires analysis of a frame, when
+//                 needed, is geometry::MultiresShape::Analyze of its finest control points).
 //
 // Snapping along normals only moves points across the surface: vertices of different
 // frames correspond only approximately (tangential drift). Motion initialization
@@ -94,7 +95,6 @@ struct FrameShapeInit {
   geometry::TriangleMesh hull;               // the visual-hull iso-surface H_f
   std::vector<geometry::Positions> control;  // fitted control points, levels 0..n
   std::vector<LevelFitSummary> fit;          // per level
-  geometry::MultiresShape shape;             // analysis of control.back()
   double carve_seconds = 0, isosurface_seconds = 0, fit_seconds = 0;
 };
 
