@@ -68,7 +68,8 @@ void RunStageCommand(solver::Stage stage, const std::string& name, const StageAr
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
   ProgressBar progress;
   const output::CommandRun run{name, arguments.out, arguments.overwrite, false, InvocationArguments()};
-  output::RunStage(stage, run, dataset, options, in ? &*in : nullptr, arguments.out, &progress);
+  // keep_frames false: the shape stage streams its frames to the folder (docs/cluster.md).
+  output::RunStage(stage, run, dataset, options, in ? &*in : nullptr, arguments.out, &progress, false);
   spdlog::info("{}: stage folder written to {}", name, arguments.out);
 }
 

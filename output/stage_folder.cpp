@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 
 #include "core/error.h"
 #include "core/file_status.h"
@@ -30,22 +31,50 @@ geometry::TriangleMesh ReadStageMesh(const fs::path& path) {
   return geometry::ReadMesh(path.string(), options);
 }
 
-// meshes/<frame>.ply: the fitted limit surfaces with their motion to the next frame, as
-// WriteResultMeshes writes them, two frames in memory at a time rather than the take.
-void WriteFittedSurfaces(const std::string& folder, const solver::StageState& state) {
-  const geometry::Faces& faces = state.Hierarchy().LevelFaces(state.Hierarchy().finest_level());
+// meshes/<frame>.ply: the fitted limit surfaces of the frames first_frame + i, i < count,
+// with their motion to the next frame, as WriteResultMeshes writes them, two frames in
+// memory at a time rather than the take. control(i): index i's finest control points.
+void WriteFittedSurfaces(const std::string& folder, const geometry::LoopHierarchy& hierarchy, int first_frame,
+                         int count, const std::function<geometry::Positions(int)>& control) {
+  const int finest = hierarchy.finest_level();
+  const geometry::Faces& faces = hierarchy.LevelFaces(finest);
+  const auto surface_of = [&](int i) { return geometry::Positions(hierarchy.LimitPositions(finest) * control(i)); };
   std::error_code error;
   fs::create_directories(fs::path(folder) / "meshes", error);
   if (error) ThrowError(folder + "/meshes", "", "cannot create the directory: " + error.message());
-  geometry::Positions surface = state.Surface(0);
-  for (int i = 0; i < state.frame_count(); ++i) {
-    geometry::Positions next = i + 1 < state.frame_count() ? state.Surface(i + 1) : geometry::Positions();
-    const geometry::Positions motion = i + 1 < state.frame_count()
+  geometry::Positions surface = surface_of(0);
+  for (int i = 0; i < count; ++i) {
+    geometry::Positions next = i + 1 < count ? surface_of(i + 1) : geometry::Positions();
+    const geometry::Positions motion = i + 1 < count
                                            ? geometry::Positions(next - surface)
                                            : geometry::Positions(geometry::Positions::Zero(surface.rows(), 3));
-    WriteResultMesh(folder, state.first_frame + i, faces, surface, motion);
+    WriteResultMesh(folder, first_frame + i, faces, surface, motion);
     surface = std::move(next);
   }
+}
+
+// Creates `folder` and removes its report.json: unfinished until WriteStageReport.
+void BeginStageFolder(const std::string& folder) {
+  std::error_code error;
+  fs::create_directories(folder, error);
+  if (error) ThrowError(folder, "", "cannot create the stage folder: " + error.message());
+  fs::remove(ReportPath(folder), error);
+  if (error) ThrowError(ReportPath(folder), "", "cannot remove: " + error.message());
+}
+
+// report.json, last: record's report with the layout fields of `state` over `frame_count` frames.
+void WriteStageReport(const std::string& folder, const StageRecord& record, int frame_count) {
+  const solver::StageState& state = record.state;
+  nlohmann::json report = record.report;
+  report["stage_layout_version"] = kStageLayoutVersion;
+  report["frames"] = {{"first", state.first_frame}, {"count", frame_count}};
+  report["reference_frame"] = state.reference_frame;
+  // The take's reference frame (shape initialization's), kept through ranges and seeds.
+  report["take_reference_frame"] = record.report.value("take_reference_frame", state.reference_frame);
+  report["levels"] = state.Hierarchy().finest_level();
+  report["evidence"] = vision::ToString(state.evidence);
+  report["image_scales"] = state.image_scales;
+  WriteJsonFile(ReportPath(folder), report);
 }
 
 }  // namespace
@@ -54,31 +83,41 @@ void WriteStageFolder(const std::string& folder, const StageRecord& record,
                       const std::vector<std::vector<geometry::Positions>>* all_levels) {
   const solver::StageState& state = record.state;
   state.Check(folder);
-  std::error_code error;
-  fs::create_directories(folder, error);
-  if (error) ThrowError(folder, "", "cannot create the stage folder: " + error.message());
-  fs::remove(ReportPath(folder), error);  // unfinished from here until the new report
-  if (error) ThrowError(ReportPath(folder), "", "cannot remove: " + error.message());
-
+  BeginStageFolder(folder);
   const geometry::LoopHierarchy& hierarchy = state.Hierarchy();
   WriteHullFiles(folder, state.base_mesh, state.first_frame, state.hulls, kExact);
   if (all_levels) {
     WriteControlFiles(folder, hierarchy, state.first_frame, *all_levels, kExact);
-    WriteFittedSurfaces(folder, state);
+    WriteFittedSurfaces(folder, hierarchy, state.first_frame, state.frame_count(),
+                        [&](int i) { return state.control[i]; });
   } else {
     WriteFinestControlFiles(folder, hierarchy, state.first_frame, state.control, kExact);
   }
+  WriteStageReport(folder, record, state.frame_count());
+}
 
-  nlohmann::json report = record.report;
-  report["stage_layout_version"] = kStageLayoutVersion;
-  report["frames"] = {{"first", state.first_frame}, {"count", state.frame_count()}};
-  report["reference_frame"] = state.reference_frame;
-  // The take's reference frame (shape initialization's), kept through ranges and seeds.
-  report["take_reference_frame"] = record.report.value("take_reference_frame", state.reference_frame);
-  report["levels"] = hierarchy.finest_level();
-  report["evidence"] = vision::ToString(state.evidence);
-  report["image_scales"] = state.image_scales;
-  WriteJsonFile(ReportPath(folder), report);
+ShapeStageFolderStore::ShapeStageFolderStore(std::string folder) : folder_(std::move(folder)) {
+  BeginStageFolder(folder_);
+}
+
+void ShapeStageFolderStore::StoreHull(int frame, const geometry::TriangleMesh& hull) {
+  WriteHullFile(folder_, frame, hull, kExact);
+}
+
+geometry::TriangleMesh ShapeStageFolderStore::LoadHull(int frame) const { return ReadStageHull(folder_, frame); }
+
+void ShapeStageFolderStore::StoreControl(int frame, const geometry::LoopHierarchy& hierarchy,
+                                         const std::vector<geometry::Positions>& levels) {
+  WriteFrameControlFiles(folder_, hierarchy, frame, levels, kExact);
+  ++frames_fitted_;
+}
+
+void FinishShapeStageFolder(const std::string& folder, const StageRecord& record, int frame_count) {
+  const solver::StageState& state = record.state;
+  geometry::WriteMesh((fs::path(folder) / "base_mesh.ply").string(), state.base_mesh, nullptr, kExact);
+  WriteFittedSurfaces(folder, state.Hierarchy(), state.first_frame, frame_count,
+                      [&](int i) { return ReadStageControl(folder, state.first_frame + i, state.Hierarchy()); });
+  WriteStageReport(folder, record, frame_count);
 }
 
 bool StageFolderComplete(const std::string& folder) { return IsFile(ReportPath(folder)); }

@@ -39,6 +39,30 @@ struct StageRecord {
 void WriteStageFolder(const std::string& folder, const StageRecord& record,
                       const std::vector<std::vector<geometry::Positions>>* all_levels = nullptr);
 
+// A solver::ShapeFrameStore writing a shape stage folder while shape initialization makes
+// it (the `shape` command: memory independent of the take's length): hull/<frame>.ply and
+// control/<frame>/level_<i>.ply as doubles, the exact values, a hull read back from its
+// file when it is needed again. Creating it marks the folder unfinished (removes its
+// report.json); FinishShapeStageFolder completes it.
+class ShapeStageFolderStore : public solver::ShapeFrameStore {
+ public:
+  explicit ShapeStageFolderStore(std::string folder);
+  void StoreHull(int frame, const geometry::TriangleMesh& hull) override;
+  geometry::TriangleMesh LoadHull(int frame) const override;
+  void StoreControl(int frame, const geometry::LoopHierarchy& hierarchy,
+                    const std::vector<geometry::Positions>& levels) override;
+  int frames_fitted() const { return frames_fitted_; }  // frames whose control points were stored
+
+ private:
+  std::string folder_;
+  int frames_fitted_ = 0;
+};
+
+// Completes the shape stage folder a ShapeStageFolderStore wrote the `frame_count` frames
+// of: base_mesh.ply, meshes/ (from the finest control points read back two frames at a
+// time) and, last, report.json (`record`: the stage's report and its state without frames).
+void FinishShapeStageFolder(const std::string& folder, const StageRecord& record, int frame_count);
+
 // True when `folder`/report.json exists: the stage that wrote the folder finished.
 bool StageFolderComplete(const std::string& folder);
 

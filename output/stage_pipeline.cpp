@@ -1,6 +1,7 @@
 #include "output/stage_pipeline.h"
 
 #include <filesystem>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -34,10 +35,11 @@ nlohmann::json OptionsOf(const solver::ReconstructionOptions& options, Stage sta
 solver::StageState RunSolverStage(Stage stage, const vision::Dataset& dataset,
                                   const solver::ReconstructionOptions& options, const StageRecord* in,
                                   Progress* progress, nlohmann::json* section, std::string* brief,
-                                  std::vector<std::vector<geometry::Positions>>* all_levels) {
+                                  std::vector<std::vector<geometry::Positions>>* all_levels,
+                                  solver::ShapeFrameStore* store) {
   if (stage == Stage::kShape) {
     solver::ShapeInitResult figures;
-    solver::StageState state = solver::RunShapeStage(dataset, options.shape, progress, &figures);
+    solver::StageState state = solver::RunShapeStage(dataset, options.shape, progress, &figures, store);
     *section = ShapeInitJson(dataset, options.shape, figures);
     *brief = figures.BriefReport();
     // Moved, not copied: the figures go when this returns, the levels are written next.
@@ -89,13 +91,17 @@ nlohmann::json StageOptionsJson(const solver::ReconstructionOptions& options, St
 
 StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& dataset,
                      const solver::ReconstructionOptions& options, const StageRecord* in, const std::string& folder,
-                     Progress* progress) {
+                     Progress* progress, bool keep_frames) {
   const Stopwatch start;
   StageRecord record;
   nlohmann::json section;
   std::string brief;
   std::vector<std::vector<geometry::Positions>> all_levels;
-  record.state = RunSolverStage(stage, dataset, options, in, progress, &section, &brief, &all_levels);
+  // The shape stage without keep_frames writes its frames into the folder as it makes them.
+  std::optional<ShapeStageFolderStore> store;
+  if (stage == Stage::kShape && !keep_frames) store.emplace(folder);
+  record.state = RunSolverStage(stage, dataset, options, in, progress, &section, &brief, &all_levels,
+                                store ? &*store : nullptr);
   const double seconds = start.Seconds();
   spdlog::info("{}", brief);
 
@@ -115,7 +121,10 @@ StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& 
   report["options"][StageSection(stage)] = OptionsOf(options, stage);
   report[StageSection(stage)] = section;
   report["timings_seconds"][StageSection(stage)] = seconds;
-  WriteStageFolder(folder, record, all_levels.empty() ? nullptr : &all_levels);
+  if (store)
+    FinishShapeStageFolder(folder, record, store->frames_fitted());
+  else
+    WriteStageFolder(folder, record, all_levels.empty() ? nullptr : &all_levels);
   return record;
 }
 

@@ -36,9 +36,13 @@ nlohmann::json StageOptionsJson(const solver::ReconstructionOptions& options, so
 // its stage folder `folder` (which the caller prepared) and returns its record. The
 // report: the head of `run`, "stage", and, carried on from in's report and extended by
 // this stage, "options" (per stage section), each stage's figures and "timings_seconds".
+// Without `keep_frames` (the stage commands, which read the record no further), the shape
+// stage writes each frame's hull and fit into the folder as it makes them
+// (ShapeStageFolderStore) and the record's state holds no frames: its memory does not
+// grow with the take. The folder's files are the same either way.
 StageRecord RunStage(solver::Stage stage, const CommandRun& run, const vision::Dataset& dataset,
                      const solver::ReconstructionOptions& options, const StageRecord* in, const std::string& folder,
-                     Progress* progress = nullptr);
+                     Progress* progress = nullptr, bool keep_frames = true);
 
 // The OUTPUT.md result of the final stage's frames and report in run.out (prepared by the
 // caller): the split and meshes/, obj/, control/, hull/ frame by frame (WriteSequence),
