@@ -163,6 +163,46 @@ std::vector<vision::Silhouette> StillSilhouettes(const vision::Dataset& dataset,
   return silhouettes;
 }
 
+// Fits the hierarchy to every frame's hull (FrameShapeInit::fit and fit_seconds; the
+// control points of levels 0..n to `store`), outwards from the reference frame. A frame
+// starts from its neighbour's fitted base, the frame fitted last on its side of the
+// reference frame: only those two bases are kept. Returns the reference frame's finest
+// control points.
+geometry::Positions FitEveryFrame(const HierarchyFitOptions& options, ShapeFrameStore* store, Progress* progress,
+                                  ShapeInitResult* result) {
+  const int count = static_cast<int>(result->frames.size());
+  const int reference_index = result->reference_frame - result->frames.front().frame;
+  ProgressBegin(progress, "fit subdivision surface", count);
+  std::vector<int> order{reference_index};
+  for (int d = 1; d < count; ++d) {
+    if (reference_index - d >= 0) order.push_back(reference_index - d);
+    if (reference_index + d < count) order.push_back(reference_index + d);
+  }
+  int done = 0;
+  geometry::Positions base_before, base_after, reference_control;  // sides i < and i > reference_index
+  for (int i : order) {
+    FrameShapeInit& frame = result->frames[i];
+    const Stopwatch start;
+    const geometry::Positions& initial_base =
+        i == reference_index ? result->base_mesh.V : (i < reference_index ? base_before : base_after);
+    const geometry::ClosestPointTree hull_tree(store->LoadHull(frame.frame),
+                                               "visual hull of frame " + vision::FrameName(frame.frame));
+    const std::vector<geometry::Positions> control =
+        FitHierarchyToSurface(*result->hierarchy, initial_base, hull_tree, options, &frame.fit);
+    frame.fit_seconds = start.Seconds();
+    if (i == reference_index) {
+      base_before = base_after = control.front();
+      reference_control = control.back();
+    } else {
+      (i < reference_index ? base_before : base_after) = control.front();
+    }
+    store->StoreControl(frame.frame, *result->hierarchy, control);
+    ProgressUpdate(progress, ++done);
+  }
+  ProgressEnd(progress);
+  return reference_control;
+}
+
 }  // namespace
 
 std::string ShapeInitResult::BriefReport() const {
@@ -291,38 +331,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
                result.base_mesh.vertex_count(), result.base_mesh.face_count(), levels,
                result.hierarchy->FaceCount(levels));
 
-  // Fit the hierarchy to every frame's hull, outwards from the reference frame.
-  ProgressBegin(progress, "fit subdivision surface", count);
-  std::vector<int> order{reference - first};
-  for (int d = 1; d < count; ++d) {
-    if (reference - first - d >= 0) order.push_back(reference - first - d);
-    if (reference - first + d < count) order.push_back(reference - first + d);
-  }
-  int done = 0;
-  // A frame starts from its neighbour's fitted base, the frame fitted last on its side of
-  // the reference frame: only those two are kept.
-  const int reference_index = reference - first;
-  geometry::Positions base_before, base_after;  // of the sides i < reference_index, i > reference_index
-  for (int i : order) {
-    FrameShapeInit& frame = result.frames[i];
-    start.Restart();
-    const geometry::Positions& initial_base =
-        i == reference_index ? result.base_mesh.V : (i < reference_index ? base_before : base_after);
-    const geometry::ClosestPointTree hull_tree(store->LoadHull(frame.frame),
-                                               "visual hull of frame " + vision::FrameName(frame.frame));
-    const std::vector<geometry::Positions> control =
-        FitHierarchyToSurface(*result.hierarchy, initial_base, hull_tree, options.fit, &frame.fit);
-    frame.fit_seconds = start.Seconds();
-    if (i == reference_index) {
-      base_before = base_after = control.front();
-      result.reference_control = control.back();
-    } else {
-      (i < reference_index ? base_before : base_after) = control.front();
-    }
-    store->StoreControl(frame.frame, *result.hierarchy, control);
-    ProgressUpdate(progress, ++done);
-  }
-  ProgressEnd(progress);
+  result.reference_control = FitEveryFrame(options.fit, store, progress, &result);
   return result;
 }
 
