@@ -36,9 +36,12 @@ void RunPlan(const PlanArguments& arguments) {
   const solver::ReconstructionOptions options = arguments.stages.Options();
   arguments.plan.Check();
   const vision::Dataset dataset(arguments.dataset);
-  output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
+  // A folder holding a plan already: WritePlan decides (CheckReplan), keeping what is
+  // still valid; any other folder as every command's output.
+  if (!fs::is_regular_file(fs::path(arguments.out) / "plan.json"))
+    output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
   const nlohmann::json plan = output::WritePlan(arguments.dataset, dataset, options, arguments.plan, arguments.out,
-                                                InvocationArguments());
+                                                arguments.overwrite, InvocationArguments());
   spdlog::info("plan: {} tasks over frames {} in {} chunks written to {}{}", plan["tasks"].size(),
                plan["frames"].dump(), plan["chunks"].get<int>(), arguments.out,
                arguments.plan.slurm ? " (sbatch scripts in slurm/, submit with slurm/submit.sh)" : "");
@@ -68,25 +71,32 @@ int RunChild(const std::vector<std::string>& argv, long* max_rss_kib) {
 // Runs task `task` of the plan in `directory` unless finished; records its status.
 void RunTask(const std::string& directory, const nlohmann::json& plan, const nlohmann::json& task) {
   const std::string id = task.at("id").get<std::string>();
-  if (output::TaskFinished(directory, task)) {
+  if (output::TaskFinished(task)) {
     spdlog::info("run-plan: {} finished already (skipped)", id);
     return;
   }
   for (const auto& dependency : task.at("depends_on"))
     for (const nlohmann::json& other : plan.at("tasks"))
-      if (other.at("id") == dependency && !output::TaskFinished(directory, other))
+      if (other.at("id") == dependency && !output::TaskFinished(other))
         ThrowError((fs::path(directory) / "plan.json").string(), "task " + id,
                    "depends on " + dependency.get<std::string>() + ", which has not finished");
   spdlog::info("run-plan: {} ({} frames {})", id, task.value("stage", ""), task.value("frames", nlohmann::json()).dump());
   const Stopwatch start;
   long max_rss_kib = 0;
+  // Its folder may hold the result of another plan's task: no longer finished from here on.
+  if (fs::exists(task.at("output").get<std::string>())) output::ForgetTaskFinished(task);
   const int exit_code = RunChild(task.at("argv").get<std::vector<std::string>>(), &max_rss_kib);
   fs::create_directories(fs::path(directory) / "status");
   output::WriteJsonFile((fs::path(directory) / "status" / (id + ".json")).string(),
-                        {{"id", id}, {"exit_code", exit_code}, {"seconds", start.Seconds()}, {"max_rss_kib", max_rss_kib}});
+                        {{"id", id},
+                         {"stamp", task.at("stamp")},
+                         {"exit_code", exit_code},
+                         {"seconds", start.Seconds()},
+                         {"max_rss_kib", max_rss_kib}});
   if (exit_code != 0)
     ThrowError((fs::path(directory) / "plan.json").string(), "task " + id,
                "failed (exit code " + std::to_string(exit_code) + "); run-plan again re-runs it and what follows");
+  output::RecordTaskFinished(task);
 }
 
 struct RunPlanArguments {

@@ -68,7 +68,8 @@ void RunStageCommand(solver::Stage stage, const std::string& name, const StageAr
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
   ProgressBar progress;
   const output::CommandRun run{name, arguments.out, arguments.overwrite, false, InvocationArguments()};
-  output::RunStage(stage, run, dataset, options, in ? &*in : nullptr, arguments.out, &progress);
+  // keep_frames false: the shape stage streams its frames to the folder (docs/cluster.md).
+  output::RunStage(stage, run, dataset, options, in ? &*in : nullptr, arguments.out, &progress, false);
   spdlog::info("{}: stage folder written to {}", name, arguments.out);
 }
 
@@ -118,16 +119,16 @@ struct SplitArguments {
 void RunSplit(const SplitArguments& arguments) {
   const Stopwatch start;
   const vision::Dataset dataset(arguments.dataset);
-  const output::StageRecord last = output::ReadStageFolder(arguments.from);
+  // Frame by frame from the folder: memory does not grow with the take (docs/cluster.md).
+  const output::StageFolderFrames last(arguments.from);
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite);
   // A named copy: items() of the temporary value() returns would dangle in the loop.
-  const nlohmann::json options = last.report.value("options", nlohmann::json::object());
+  const nlohmann::json options = last.report().value("options", nlohmann::json::object());
   nlohmann::json stages = nlohmann::json::object();
   for (const auto& [section, ignored] : options.items()) stages[section] = "loaded";
   const output::CommandRun run{"split", arguments.out, arguments.overwrite, false, InvocationArguments()};
-  output::WriteReconstruction(run, dataset, options, last, stages, start);
-  spdlog::info("split: {} frames written to {} in {:.1f} s", last.state.frame_count(), arguments.out,
-               start.Seconds());
+  output::WriteReconstruction(run, dataset, options, last.report(), last, stages, start);
+  spdlog::info("split: {} frames written to {} in {:.1f} s", last.frame_count(), arguments.out, start.Seconds());
 }
 
 struct MergeArguments {

@@ -7,7 +7,9 @@
 #include "core/error.h"
 #include "core/json_reader.h"
 #include "output/options_json.h"
+#include "output/report.h"
 #include "output/result_writer.h"
+#include "output/stage_pipeline.h"
 
 namespace subflow::output {
 
@@ -28,13 +30,16 @@ struct Range {
 
 class PlanBuilder {
  public:
-  PlanBuilder(std::string dataset, std::string directory) : dataset_(std::move(dataset)), directory_(std::move(directory)) {}
+  PlanBuilder(std::string dataset, std::string directory, const solver::ReconstructionOptions& options)
+      : dataset_(std::move(dataset)), directory_(std::move(directory)), options_(options) {}
 
   std::string Folder(const std::string& name) const { return (fs::path(directory_) / name).string(); }
 
   // Adds a task running `arguments` (after the subcommand DATASET, when `with_dataset`).
   void Add(const std::string& id, const std::string& stage, Range frames, std::vector<std::string> arguments,
-           const std::vector<std::string>& inputs, const std::string& output, std::vector<std::string> depends_on) {
+           const std::vector<std::string>& inputs, const std::string& output, std::vector<std::string> depends_on,
+           nlohmann::json options_read = nullptr) {
+    options_read_.push_back(std::move(options_read));
     nlohmann::json argv = nlohmann::json::array();
     for (std::string& argument : arguments) argv.push_back(std::move(argument));
     tasks_.push_back({{"id", id},
@@ -56,7 +61,12 @@ class PlanBuilder {
       arguments.insert(arguments.end(), {"--seed", seed});
       inputs.push_back(seed);
     }
-    Add(id, stage, frames, arguments, inputs, Folder(id), depends_on);
+    Add(id, stage, frames, arguments, inputs, Folder(id), depends_on, StageOptionsRead(stage));
+  }
+
+  // What a stage task reads of options.json: as its stage report records it.
+  nlohmann::json StageOptionsRead(const std::string& stage) const {
+    return StageOptionsJson(options_, StageNamed(stage, "plan"));
   }
 
   // Chained chunks of a motion pass (motion or retrack) on `from`; returns their ids.
@@ -86,18 +96,24 @@ class PlanBuilder {
     Add(id, stage, frames, arguments, inputs, Folder(id), ids);
   }
 
-  nlohmann::json& tasks() { return tasks_; }
+  // The tasks, each with its stamp (StampTasks).
+  nlohmann::json StampedTasks(const nlohmann::json& dataset) {
+    StampTasks(&tasks_, options_read_, dataset);
+    return tasks_;
+  }
 
  private:
   std::string dataset_, directory_;
+  const solver::ReconstructionOptions& options_;
   nlohmann::json tasks_ = nlohmann::json::array();
+  std::vector<nlohmann::json> options_read_;  // per task: the options it reads (StampTasks)
 };
 
 }  // namespace
 
 nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dataset& dataset,
                          const solver::ReconstructionOptions& options, const PlanOptions& plan_options,
-                         const std::string& directory_name, const nlohmann::json& arguments) {
+                         const std::string& directory_name, bool overwrite, const nlohmann::json& arguments) {
   options.Check();
   plan_options.Check();
   const std::string directory = fs::absolute(directory_name).lexically_normal().string();
@@ -114,11 +130,11 @@ nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dat
   const int reference_chunk = std::clamp((reference - take.first) / plan_options.chunk, 0,
                                          static_cast<int>(chunks.size()) - 1);
 
-  PlanBuilder plan(dataset_path, directory);
+  PlanBuilder plan(dataset_path, directory, options);
   plan.Add("shape", "shape", take,
            {"shape", dataset_path, "--out", plan.Folder("shape"), "--overwrite", "--options",
             plan.Folder("options.json")},
-           {}, plan.Folder("shape"), {});
+           {}, plan.Folder("shape"), {}, plan.StageOptionsRead("shape"));
   std::string last = "motion_merge";
   plan.AddMerge("motion_merge", "motion", take, plan.AddChain("motion", chunks, reference_chunk, plan.Folder("shape"), "shape"));
   if (options.refine) {
@@ -152,7 +168,8 @@ nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dat
                          {"chunks", chunks.size()},
                          {"options", "options.json"},
                          {"result", plan.Folder("result")},
-                         {"tasks", plan.tasks()}};
+                         {"tasks", plan.StampedTasks(DatasetJson(dataset))}};
+  CheckReplan(directory, json, overwrite);
   WriteJsonFile((fs::path(directory) / "options.json").string(), nlohmann::json(options));
   WriteJsonFile((fs::path(directory) / "plan.json").string(), json);
   if (plan_options.slurm) WriteSlurmScripts(directory, json, plan_options.memory_mib);
@@ -164,20 +181,17 @@ nlohmann::json ReadPlan(const std::string& directory) {
   nlohmann::json plan = ReadJsonFile(path, "a plan (subflow plan)");
   const JsonReader reader(path);
   if (reader.Integer(reader.Required(plan, "plan_version", ""), "plan_version", 0, 1 << 20) != kPlanVersion)
-    reader.Fail("plan_version", "expected " + std::to_string(kPlanVersion));
+    reader.Fail("plan_version", "expected " + std::to_string(kPlanVersion) +
+                                    " (a plan of another subflow version: plan it again with --overwrite)");
   const nlohmann::json& tasks = reader.Required(plan, "tasks", "");
   if (!tasks.is_array() || tasks.empty()) reader.Fail("tasks", "expected a non-empty array");
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     const std::string where = "tasks[" + std::to_string(i) + "]";
-    for (const char* key : {"id", "output"}) reader.String(reader.Required(tasks[i], key, where), where + "." + key);
+    for (const char* key : {"id", "output", "stamp"}) reader.String(reader.Required(tasks[i], key, where), where + "." + key);
     for (const char* key : {"argv", "depends_on"})
       if (!reader.Required(tasks[i], key, where).is_array()) reader.Fail(where + "." + key, "expected an array");
   }
   return plan;
-}
-
-bool TaskFinished(const std::string& directory, const nlohmann::json& task) {
-  return fs::is_regular_file(fs::path(task.at("output").get<std::string>()) / "report.json");
 }
 
 }  // namespace subflow::output

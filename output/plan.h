@@ -16,8 +16,9 @@
 //   refine_merge      each frame from the chunk that holds it most inside
 //   retrack_<c>       as motion, chained, on the refined shapes
 //   retrack_merge, split   the OUTPUT.md result in DIR/result
-// Every task lists its inputs, its output folder and the tasks it depends on; a task is
-// finished when its output folder holds report.json (written last).
+// Every task lists its inputs, its output folder, the tasks it depends on and its stamp
+// (StampTasks); a task is finished when its output folder holds report.json (written
+// last) and the stamp of the plan it was run for equals its stamp in this plan.
 #pragma once
 
 #include <string>
@@ -30,7 +31,11 @@
 
 namespace subflow::output {
 
-inline constexpr int kPlanVersion = 1;
+// 2: tasks carry a "stamp" (plans of version 1 do not; plan them again with --overwrite).
+inline constexpr int kPlanVersion = 2;
+
+// The file in a task's output folder holding the stamp of the task it was run for.
+inline constexpr const char* kTaskStampFile = "task_stamp.json";
 
 struct PlanOptions {
   int chunk = 24;    // frames per chunk (≥ 2)
@@ -48,16 +53,42 @@ inline constexpr int kDefaultTaskMemoryMiB = 4096;
 // Builds the plan of `options` on `dataset` for the directory `directory` (absolute paths
 // in the task arguments) and writes directory/plan.json and directory/options.json (the
 // options every task reads: --options); with options.slurm, also directory/slurm/.
-// `arguments`: the command line of `subflow plan`, recorded in plan.json. Returns the plan.
+// When `directory` holds a plan already, CheckReplan(directory, plan, overwrite) decides
+// first. `arguments`: the command line of `subflow plan`, recorded in plan.json. Returns
+// the plan.
 nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dataset& dataset,
                          const solver::ReconstructionOptions& options, const PlanOptions& plan_options,
-                         const std::string& directory, const nlohmann::json& arguments = nlohmann::json::object());
+                         const std::string& directory, bool overwrite,
+                         const nlohmann::json& arguments = nlohmann::json::object());
 
 // Reads directory/plan.json; throws subflow::Error naming it.
 nlohmann::json ReadPlan(const std::string& directory);
 
-// Whether task `task` of a plan in `directory` is finished (its output holds report.json).
-bool TaskFinished(const std::string& directory, const nlohmann::json& task);
+// Gives every task of `tasks` (in an order where a task follows those it depends on) its
+// "stamp": a 64-bit fingerprint of its definition, the canonical JSON (sorted keys) of
+//   argv         the command line (dataset, frames, input and output folders, seed)
+//   options      options_read[i]: the options the task reads from options.json (a stage
+//                task: every stage's options up to its own, as its stage report records
+//                them; null for merge and split, which read none)
+//   dataset      `dataset` (output::DatasetJson: directory, frames, cameras, bounds, …)
+//   depends_on   {id: stamp} of the tasks it depends on,
+// so a task's stamp changes with anything upstream of it, transitively.
+void StampTasks(nlohmann::json* tasks, const std::vector<nlohmann::json>& options_read, const nlohmann::json& dataset);
+
+// Whether task `task` of a plan is finished: its output holds report.json
+// and kTaskStampFile with the task's stamp (a folder left by another plan is not).
+bool TaskFinished(const nlohmann::json& task);
+// Removes the stamp in task's output folder (before the task runs again).
+void ForgetTaskFinished(const nlohmann::json& task);
+// Writes task's stamp into its output folder (after the task succeeded).
+void RecordTaskFinished(const nlohmann::json& task);
+
+// Planning `plan` into `directory` when it holds a plan already: returns when that plan
+// has the same tasks with the same stamps (nothing of its results changes meaning) or
+// when `overwrite` is set (then a finished task whose stamp is unchanged stays finished and
+// the others run again, as TaskFinished sees it). Otherwise throws subflow::Error naming
+// the directory and the tasks defined otherwise, added or no longer planned.
+void CheckReplan(const std::string& directory, const nlohmann::json& plan, bool overwrite);
 
 // Writes directory/slurm/: one sbatch script per stage phase (job arrays for the refine
 // chunks), --dependency=afterok between them, and submit.sh that submits them in order.

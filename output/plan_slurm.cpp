@@ -17,13 +17,15 @@ namespace fs = std::filesystem;
 namespace {
 
 // The memory to request for `task` (MiB): `fixed`, else 1.5 × the peak a finished run-plan
-// of this plan measured (status/<id>.json), else kDefaultTaskMemoryMiB.
+// of this plan measured (status/<id>.json, when measured for the task as this plan defines
+// it: a re-planned task's memory may differ), else kDefaultTaskMemoryMiB.
 int TaskMemoryMiB(const std::string& directory, const nlohmann::json& task, int fixed) {
   if (fixed > 0) return fixed;
   const fs::path status = fs::path(directory) / "status" / (task.at("id").get<std::string>() + ".json");
   if (fs::is_regular_file(status)) {
     const nlohmann::json measured = ReadJsonFile(status.string(), "a task status (subflow run-plan)");
-    const double kib = measured.value("max_rss_kib", 0.0);
+    const bool same_task = measured.value("stamp", std::string()) == task.value("stamp", std::string());
+    const double kib = same_task ? measured.value("max_rss_kib", 0.0) : 0.0;
     if (kib > 0) return std::max(256, static_cast<int>(std::ceil(1.5 * kib / 1024.0)));
   }
   return kDefaultTaskMemoryMiB;

@@ -142,7 +142,7 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
                       {"mean_silhouette_iou", Finite(frame.carving.mean_silhouette_iou)},
                       {"cameras", cameras},
                       {"warnings", frame.carving.warnings},
-                      {"hull", {{"vertices", frame.hull.vertex_count()}, {"faces", frame.hull.face_count()}}},
+                      {"hull", {{"vertices", frame.hull_vertices}, {"faces", frame.hull_faces}}},
                       {"fit", fit_levels},
                       {"seconds", {{"carve", frame.carve_seconds},
                                    {"isosurface", frame.isosurface_seconds},

@@ -13,9 +13,13 @@ void WriteHullFiles(const std::string& out, const geometry::TriangleMesh& base_m
   const fs::path root(out);
   fs::create_directories(root / "hull");
   geometry::WriteMesh((root / "base_mesh.ply").string(), base_mesh, nullptr, format);
-  for (std::size_t i = 0; i < hulls.size(); ++i)
-    geometry::WriteMesh((root / "hull" / (vision::FrameName(first_frame + static_cast<int>(i)) + ".ply")).string(),
-                        hulls[i], nullptr, format);
+  for (std::size_t i = 0; i < hulls.size(); ++i) WriteHullFile(out, first_frame + static_cast<int>(i), hulls[i], format);
+}
+
+void WriteHullFile(const std::string& out, int frame, const geometry::TriangleMesh& hull, geometry::PlyFormat format) {
+  const fs::path directory = fs::path(out) / "hull";
+  fs::create_directories(directory);
+  geometry::WriteMesh((directory / (vision::FrameName(frame) + ".ply")).string(), hull, nullptr, format);
 }
 
 std::string ControlFilePath(const std::string& out, int frame, int level) {
@@ -37,9 +41,13 @@ void WriteControlFile(const std::string& out, const geometry::LoopHierarchy& hie
 void WriteControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int first_frame,
                        const std::vector<std::vector<geometry::Positions>>& levels, geometry::PlyFormat format) {
   for (std::size_t i = 0; i < levels.size(); ++i)
-    for (std::size_t level = 0; level < levels[i].size(); ++level)
-      WriteControlFile(out, hierarchy, first_frame + static_cast<int>(i), static_cast<int>(level), levels[i][level],
-                       format);
+    WriteFrameControlFiles(out, hierarchy, first_frame + static_cast<int>(i), levels[i], format);
+}
+
+void WriteFrameControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int frame,
+                            const std::vector<geometry::Positions>& levels, geometry::PlyFormat format) {
+  for (std::size_t level = 0; level < levels.size(); ++level)
+    WriteControlFile(out, hierarchy, frame, static_cast<int>(level), levels[level], format);
 }
 
 void WriteFinestControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int first_frame,
@@ -50,11 +58,14 @@ void WriteFinestControlFiles(const std::string& out, const geometry::LoopHierarc
 
 void WriteObjSequence(const std::string& out, int first_frame, const geometry::Faces& faces,
                       const std::vector<geometry::Positions>& positions) {
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    WriteObjFile(out, first_frame + static_cast<int>(i), faces, positions[i]);
+}
+
+void WriteObjFile(const std::string& out, int frame, const geometry::Faces& faces, const geometry::Positions& V) {
   const fs::path directory = fs::path(out) / "obj";
   fs::create_directories(directory);
-  for (std::size_t i = 0; i < positions.size(); ++i)
-    geometry::WriteMesh((directory / (vision::FrameName(first_frame + static_cast<int>(i)) + ".obj")).string(),
-                        geometry::TriangleMesh{positions[i], faces});
+  geometry::WriteMesh((directory / (vision::FrameName(frame) + ".obj")).string(), geometry::TriangleMesh{V, faces});
 }
 
 }  // namespace subflow::output

@@ -21,11 +21,19 @@ void WriteHullFiles(const std::string& out, const geometry::TriangleMesh& base_m
                     const std::vector<geometry::TriangleMesh>& hulls,
                     geometry::PlyFormat format = geometry::PlyFormat::kBinaryLittleEndian);
 
+// hull/<frame>.ply of one frame (the directory is created when missing).
+void WriteHullFile(const std::string& out, int frame, const geometry::TriangleMesh& hull,
+                   geometry::PlyFormat format = geometry::PlyFormat::kBinaryLittleEndian);
+
 // control/<frame>/level_<i>.ply; levels[f] holds the control points of levels 0..k of
 // frame first_frame + f (k ≤ n).
 void WriteControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int first_frame,
                        const std::vector<std::vector<geometry::Positions>>& levels,
                        geometry::PlyFormat format = geometry::PlyFormat::kBinaryLittleEndian);
+// control/<frame>/level_<i>.ply of one frame: levels[i] holds level i's control points.
+void WriteFrameControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int frame,
+                            const std::vector<geometry::Positions>& levels,
+                            geometry::PlyFormat format = geometry::PlyFormat::kBinaryLittleEndian);
 // control/<frame>/level_<n>.ply alone: each frame's finest control points.
 void WriteFinestControlFiles(const std::string& out, const geometry::LoopHierarchy& hierarchy, int first_frame,
                              const std::vector<geometry::Positions>& finest, geometry::PlyFormat format);
@@ -35,5 +43,7 @@ std::string ControlFilePath(const std::string& out, int frame, int level);
 // obj/<frame>.obj for every frame's vertices (same faces).
 void WriteObjSequence(const std::string& out, int first_frame, const geometry::Faces& faces,
                       const std::vector<geometry::Positions>& positions);
+// obj/<frame>.obj of one frame (the directory is created when missing).
+void WriteObjFile(const std::string& out, int frame, const geometry::Faces& faces, const geometry::Positions& V);
 
 }  // namespace subflow::output

@@ -49,17 +49,24 @@ void WriteResultMeshes(const std::string& directory, int first_frame, const geom
     const geometry::Positions motion =
         i + 1 < frame_count ? geometry::Positions(positions[i + 1] - V)
                             : geometry::Positions(geometry::Positions::Zero(V.rows(), 3));
-    geometry::VertexProperties properties;
-    properties.names = {"vx", "vy", "vz"};
-    for (int axis = 0; axis < 3; ++axis)
-      properties.values[properties.names[axis]] = motion.col(axis);
-    for (const auto& [name, values] : per_frame_properties) {
-      properties.names.push_back(name);
-      properties.values[name] = values.at(i);
-    }
-    geometry::WriteMesh((meshes / (vision::FrameName(first_frame + i) + ".ply")).string(),
-                        geometry::TriangleMesh{V, faces}, &properties);
+    std::map<std::string, Eigen::VectorXd> properties;
+    for (const auto& [name, values] : per_frame_properties) properties[name] = values.at(i);
+    WriteResultMesh(directory, first_frame + i, faces, V, motion, properties);
   }
+}
+
+void WriteResultMesh(const std::string& directory, int frame, const geometry::Faces& faces,
+                     const geometry::Positions& V, const geometry::Positions& motion,
+                     const std::map<std::string, Eigen::VectorXd>& extra) {
+  geometry::VertexProperties properties;
+  properties.names = {"vx", "vy", "vz"};
+  for (int axis = 0; axis < 3; ++axis) properties.values[properties.names[axis]] = motion.col(axis);
+  for (const auto& [name, values] : extra) {
+    properties.names.push_back(name);
+    properties.values[name] = values;
+  }
+  geometry::WriteMesh((fs::path(directory) / "meshes" / (vision::FrameName(frame) + ".ply")).string(),
+                      geometry::TriangleMesh{V, faces}, &properties);
 }
 
 void WriteJsonFile(const std::string& path, const nlohmann::json& json) {

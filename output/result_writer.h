@@ -38,6 +38,12 @@ void PrepareOutputDirectory(const std::string& directory, bool overwrite, bool r
 void WriteResultMeshes(const std::string& directory, int first_frame, const geometry::Faces& faces,
                        const std::vector<geometry::Positions>& positions,
                        const std::map<std::string, std::vector<Eigen::VectorXd>>& per_frame_properties = {});
+// One frame of WriteResultMeshes: <directory>/meshes/<frame>.ply (the directory exists)
+// with vertices V, vx vy vz = `motion` (#V×3) and `properties` (one value per vertex each,
+// written in the map's order after vx vy vz).
+void WriteResultMesh(const std::string& directory, int frame, const geometry::Faces& faces,
+                     const geometry::Positions& V, const geometry::Positions& motion,
+                     const std::map<std::string, Eigen::VectorXd>& properties = {});
 
 // Writes `json` pretty-printed to `path` (through "<path>.tmp" and a rename).
 void WriteJsonFile(const std::string& path, const nlohmann::json& json);

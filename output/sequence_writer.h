@@ -18,15 +18,20 @@
 
 #include "geometry/loop_hierarchy.h"
 #include "geometry/triangle_mesh.h"
+#include "output/stage_frames.h"
 #include "solver/rigid/rigid_split.h"
 
 namespace subflow::output {
 
-// `control`: the finest control points of frames first_frame, first_frame + 1, …; `split`
-// their rigid split (solver::SplitRigidMotion). Returns the report's "flow" section: mean
-// |flow| and |non-rigid flow| per frame step over the output vertices, vertex and face
-// counts.
-nlohmann::json WriteSequence(const std::string& out, const geometry::LoopHierarchy& hierarchy, int first_frame,
-                             const std::vector<geometry::Positions>& control, const solver::RigidSplit& split);
+// The rigid / non-rigid split (method §5) of `frames` and the files above in `out`, read
+// and written frame by frame in two passes (the energies of every frame's mesh are sums
+// over the take): the first fits the rigid motion of each frame step on the base control
+// points (solver::FitRigidMotions) and sums the energies, the second writes each frame.
+// Memory holds two frames at a time; the results equal solver::SplitRigidMotion and
+// solver::AnalyzeFlow on the whole take, bit for bit (the same operations in the same
+// order). *split gets the rigid motions (its trajectory stays empty) and the first pass's
+// time. Returns the report's "flow" section: mean |flow| and |non-rigid flow| per frame
+// step over the output vertices, vertex and face counts.
+nlohmann::json WriteSequence(const std::string& out, const StageFrames& frames, solver::RigidSplit* split);
 
 }  // namespace subflow::output

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 
 #include "core/error.h"
 #include "core/file_status.h"
@@ -9,6 +10,7 @@
 #include "geometry/mesh_io.h"
 #include "output/result_files.h"
 #include "output/result_writer.h"
+#include "output/stage_frames.h"
 #include "vision/dataset.h"
 
 namespace subflow::output {
@@ -29,45 +31,99 @@ geometry::TriangleMesh ReadStageMesh(const fs::path& path) {
   return geometry::ReadMesh(path.string(), options);
 }
 
+// meshes/<frame>.ply: the fitted limit surfaces of the frames first_frame + i, i < count,
+// with their motion to the next frame, as WriteResultMeshes writes them, two frames in
+// memory at a time rather than the take. control(i): index i's finest control points.
+void WriteFittedSurfaces(const std::string& folder, const geometry::LoopHierarchy& hierarchy, int first_frame,
+                         int count, const std::function<geometry::Positions(int)>& control) {
+  const int finest = hierarchy.finest_level();
+  const geometry::Faces& faces = hierarchy.LevelFaces(finest);
+  const auto surface_of = [&](int i) { return geometry::Positions(hierarchy.LimitPositions(finest) * control(i)); };
+  std::error_code error;
+  fs::create_directories(fs::path(folder) / "meshes", error);
+  if (error) ThrowError(folder + "/meshes", "", "cannot create the directory: " + error.message());
+  geometry::Positions surface = surface_of(0);
+  for (int i = 0; i < count; ++i) {
+    geometry::Positions next = i + 1 < count ? surface_of(i + 1) : geometry::Positions();
+    const geometry::Positions motion = i + 1 < count
+                                           ? geometry::Positions(next - surface)
+                                           : geometry::Positions(geometry::Positions::Zero(surface.rows(), 3));
+    WriteResultMesh(folder, first_frame + i, faces, surface, motion);
+    surface = std::move(next);
+  }
+}
+
+// Creates `folder` and removes its report.json: unfinished until WriteStageReport.
+void BeginStageFolder(const std::string& folder) {
+  std::error_code error;
+  fs::create_directories(folder, error);
+  if (error) ThrowError(folder, "", "cannot create the stage folder: " + error.message());
+  fs::remove(ReportPath(folder), error);
+  if (error) ThrowError(ReportPath(folder), "", "cannot remove: " + error.message());
+}
+
+// report.json, last: record's report with the layout fields of `state` over `frame_count` frames.
+void WriteStageReport(const std::string& folder, const StageRecord& record, int frame_count) {
+  const solver::StageState& state = record.state;
+  nlohmann::json report = record.report;
+  report["stage_layout_version"] = kStageLayoutVersion;
+  report["frames"] = {{"first", state.first_frame}, {"count", frame_count}};
+  report["reference_frame"] = state.reference_frame;
+  // The take's reference frame (shape initialization's), kept through ranges and seeds.
+  report["take_reference_frame"] = record.report.value("take_reference_frame", state.reference_frame);
+  report["levels"] = state.Hierarchy().finest_level();
+  report["evidence"] = vision::ToString(state.evidence);
+  report["image_scales"] = state.image_scales;
+  WriteJsonFile(ReportPath(folder), report);
+}
+
 }  // namespace
 
 void WriteStageFolder(const std::string& folder, const StageRecord& record,
                       const std::vector<std::vector<geometry::Positions>>* all_levels) {
   const solver::StageState& state = record.state;
   state.Check(folder);
-  std::error_code error;
-  fs::create_directories(folder, error);
-  if (error) ThrowError(folder, "", "cannot create the stage folder: " + error.message());
-  fs::remove(ReportPath(folder), error);  // unfinished from here until the new report
-  if (error) ThrowError(ReportPath(folder), "", "cannot remove: " + error.message());
-
+  BeginStageFolder(folder);
   const geometry::LoopHierarchy& hierarchy = state.Hierarchy();
   WriteHullFiles(folder, state.base_mesh, state.first_frame, state.hulls, kExact);
   if (all_levels) {
     WriteControlFiles(folder, hierarchy, state.first_frame, *all_levels, kExact);
-    std::vector<geometry::Positions> surfaces;
-    for (int i = 0; i < state.frame_count(); ++i) surfaces.push_back(state.Surface(i));
-    WriteResultMeshes(folder, state.first_frame, hierarchy.LevelFaces(hierarchy.finest_level()), surfaces);
+    WriteFittedSurfaces(folder, hierarchy, state.first_frame, state.frame_count(),
+                        [&](int i) { return state.control[i]; });
   } else {
     WriteFinestControlFiles(folder, hierarchy, state.first_frame, state.control, kExact);
   }
+  WriteStageReport(folder, record, state.frame_count());
+}
 
-  nlohmann::json report = record.report;
-  report["stage_layout_version"] = kStageLayoutVersion;
-  report["frames"] = {{"first", state.first_frame}, {"count", state.frame_count()}};
-  report["reference_frame"] = state.reference_frame;
-  // The take's reference frame (shape initialization's), kept through ranges and seeds.
-  report["take_reference_frame"] = record.report.value("take_reference_frame", state.reference_frame);
-  report["levels"] = hierarchy.finest_level();
-  report["evidence"] = vision::ToString(state.evidence);
-  report["image_scales"] = state.image_scales;
-  WriteJsonFile(ReportPath(folder), report);
+ShapeStageFolderStore::ShapeStageFolderStore(std::string folder) : folder_(std::move(folder)) {
+  BeginStageFolder(folder_);
+}
+
+void ShapeStageFolderStore::StoreHull(int frame, const geometry::TriangleMesh& hull) {
+  WriteHullFile(folder_, frame, hull, kExact);
+}
+
+geometry::TriangleMesh ShapeStageFolderStore::LoadHull(int frame) const { return ReadStageHull(folder_, frame); }
+
+void ShapeStageFolderStore::StoreControl(int frame, const geometry::LoopHierarchy& hierarchy,
+                                         const std::vector<geometry::Positions>& levels) {
+  WriteFrameControlFiles(folder_, hierarchy, frame, levels, kExact);
+  ++frames_fitted_;
+}
+
+void FinishShapeStageFolder(const std::string& folder, const StageRecord& record, int frame_count) {
+  const solver::StageState& state = record.state;
+  geometry::WriteMesh((fs::path(folder) / "base_mesh.ply").string(), state.base_mesh, nullptr, kExact);
+  WriteFittedSurfaces(folder, state.Hierarchy(), state.first_frame, frame_count,
+                      [&](int i) { return ReadStageControl(folder, state.first_frame + i, state.Hierarchy()); });
+  WriteStageReport(folder, record, frame_count);
 }
 
 bool StageFolderComplete(const std::string& folder) { return IsFile(ReportPath(folder)); }
 
-StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage, int first_wanted,
-                            int count_wanted) {
+StageRecord ReadStageFolderHead(const std::string& folder, const std::string& expected_stage, int first_wanted,
+                                int count_wanted, int* frame_count) {
   const std::string report_path = ReportPath(folder);
   if (!IsDirectory(folder)) ThrowError(folder, "", "not a directory (expected a stage folder)");
   if (!StageFolderComplete(folder))
@@ -116,13 +172,49 @@ StageRecord ReadStageFolder(const std::string& folder, const std::string& expect
   state.base_mesh = ReadStageMesh(root / "base_mesh.ply");
   state.hierarchy = std::make_shared<const geometry::LoopHierarchy>(
       state.base_mesh.F, state.base_mesh.vertex_count(), levels, (root / "base_mesh.ply").string());
-  for (int frame = first; frame < first + count; ++frame) {
-    state.hulls.push_back(ReadStageMesh(root / "hull" / (vision::FrameName(frame) + ".ply")));
+  *frame_count = count;
+  return record;
+}
+
+geometry::TriangleMesh ReadStageHull(const std::string& folder, int frame) {
+  return ReadStageMesh(fs::path(folder) / "hull" / (vision::FrameName(frame) + ".ply"));
+}
+
+geometry::Positions ReadStageControl(const std::string& folder, int frame, const geometry::LoopHierarchy& hierarchy) {
+  const std::string path = ControlFilePath(folder, frame, hierarchy.finest_level());
+  geometry::Positions control = ReadStageMesh(path).V;
+  const Eigen::Index expected = hierarchy.VertexCount(hierarchy.finest_level());
+  if (control.rows() != expected)
+    ThrowError(path, "", std::to_string(control.rows()) + " control points, expected #V(n) = " +
+                             std::to_string(expected) + " (the base mesh's hierarchy)");
+  return control;
+}
+
+StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage, int first_wanted,
+                            int count_wanted) {
+  int count = 0;
+  StageRecord record = ReadStageFolderHead(folder, expected_stage, first_wanted, count_wanted, &count);
+  solver::StageState& state = record.state;
+  const int levels = state.Hierarchy().finest_level();
+  for (int frame = state.first_frame; frame < state.first_frame + count; ++frame) {
+    state.hulls.push_back(ReadStageHull(folder, frame));
     state.control.push_back(ReadStageMesh(ControlFilePath(folder, frame, levels)).V);
   }
   state.Check(folder);
   return record;
 }
+
+StageFolderFrames::StageFolderFrames(const std::string& folder, const std::string& expected_stage) : folder_(folder) {
+  // In the body: frame_count_'s initializer would run after head_'s and reset it.
+  head_ = ReadStageFolderHead(folder, expected_stage, 0, -1, &frame_count_);
+}
+
+geometry::Positions StageFolderFrames::Control(int i) const {
+  return ReadStageControl(folder_, first_frame() + i, Hierarchy());
+}
+
+geometry::TriangleMesh StageFolderFrames::Hull(int i) const { return ReadStageHull(folder_, first_frame() + i); }
+
 
 void SeedStageInput(StageRecord* in, const std::string& seed) {
   const nlohmann::json report = ReadJsonFile(ReportPath(seed), "a stage report (docs/stages.md)");

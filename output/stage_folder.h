@@ -39,6 +39,30 @@ struct StageRecord {
 void WriteStageFolder(const std::string& folder, const StageRecord& record,
                       const std::vector<std::vector<geometry::Positions>>* all_levels = nullptr);
 
+// A solver::ShapeFrameStore writing a shape stage folder while shape initialization makes
+// it (the `shape` command: memory independent of the take's length): hull/<frame>.ply and
+// control/<frame>/level_<i>.ply as doubles, the exact values, a hull read back from its
+// file when it is needed again. Creating it marks the folder unfinished (removes its
+// report.json); FinishShapeStageFolder completes it.
+class ShapeStageFolderStore : public solver::ShapeFrameStore {
+ public:
+  explicit ShapeStageFolderStore(std::string folder);
+  void StoreHull(int frame, const geometry::TriangleMesh& hull) override;
+  geometry::TriangleMesh LoadHull(int frame) const override;
+  void StoreControl(int frame, const geometry::LoopHierarchy& hierarchy,
+                    const std::vector<geometry::Positions>& levels) override;
+  int frames_fitted() const { return frames_fitted_; }  // frames whose control points were stored
+
+ private:
+  std::string folder_;
+  int frames_fitted_ = 0;
+};
+
+// Completes the shape stage folder a ShapeStageFolderStore wrote the `frame_count` frames
+// of: base_mesh.ply, meshes/ (from the finest control points read back two frames at a
+// time) and, last, report.json (`record`: the stage's report and its state without frames).
+void FinishShapeStageFolder(const std::string& folder, const StageRecord& record, int frame_count);
+
 // True when `folder`/report.json exists: the stage that wrote the folder finished.
 bool StageFolderComplete(const std::string& folder);
 
@@ -51,6 +75,18 @@ bool StageFolderComplete(const std::string& folder);
 // of the wrong count.
 StageRecord ReadStageFolder(const std::string& folder, const std::string& expected_stage = "", int first = 0,
                             int count = -1);
+
+// ReadStageFolder without the frames: the report and the state's hierarchy, base mesh,
+// first and reference frame, evidence and image scales, its hulls and control empty;
+// *frame_count gets the number of frames (of the range, with count > 0). The files of
+// frame f: StageHullPath and ControlFilePath(folder, f, levels).
+StageRecord ReadStageFolderHead(const std::string& folder, const std::string& expected_stage, int first, int count,
+                                int* frame_count);
+// A stage folder's hull/<frame>.ply, read (without the manifold check: the stage that
+// wrote it had it). Throws subflow::Error naming a missing file.
+geometry::TriangleMesh ReadStageHull(const std::string& folder, int frame);
+// A stage folder's finest control points of `frame`, checked against `hierarchy`.
+geometry::Positions ReadStageControl(const std::string& folder, int frame, const geometry::LoopHierarchy& hierarchy);
 
 // Seeds `in` (a motion or retrack stage's input) from the stage folder `seed`: the frame
 // both hold (the one nearest to seed's reference frame, when several) becomes the

@@ -1,6 +1,7 @@
 #include "output/stage_pipeline.h"
 
 #include <filesystem>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 
@@ -34,13 +35,15 @@ nlohmann::json OptionsOf(const solver::ReconstructionOptions& options, Stage sta
 solver::StageState RunSolverStage(Stage stage, const vision::Dataset& dataset,
                                   const solver::ReconstructionOptions& options, const StageRecord* in,
                                   Progress* progress, nlohmann::json* section, std::string* brief,
-                                  std::vector<std::vector<geometry::Positions>>* all_levels) {
+                                  std::vector<std::vector<geometry::Positions>>* all_levels,
+                                  solver::ShapeFrameStore* store) {
   if (stage == Stage::kShape) {
     solver::ShapeInitResult figures;
-    solver::StageState state = solver::RunShapeStage(dataset, options.shape, progress, &figures);
+    solver::StageState state = solver::RunShapeStage(dataset, options.shape, progress, &figures, store);
     *section = ShapeInitJson(dataset, options.shape, figures);
     *brief = figures.BriefReport();
-    for (const solver::FrameShapeInit& frame : figures.frames) all_levels->push_back(frame.control);
+    // Moved, not copied: the figures go when this returns, the levels are written next.
+    for (solver::FrameShapeInit& frame : figures.frames) all_levels->push_back(std::move(frame.control));
     return state;
   }
   if (!in) ThrowError(StageName(stage), "input", "the stage needs the folder of the stage before it");
@@ -88,13 +91,17 @@ nlohmann::json StageOptionsJson(const solver::ReconstructionOptions& options, St
 
 StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& dataset,
                      const solver::ReconstructionOptions& options, const StageRecord* in, const std::string& folder,
-                     Progress* progress) {
+                     Progress* progress, bool keep_frames) {
   const Stopwatch start;
   StageRecord record;
   nlohmann::json section;
   std::string brief;
   std::vector<std::vector<geometry::Positions>> all_levels;
-  record.state = RunSolverStage(stage, dataset, options, in, progress, &section, &brief, &all_levels);
+  // The shape stage without keep_frames writes its frames into the folder as it makes them.
+  std::optional<ShapeStageFolderStore> store;
+  if (stage == Stage::kShape && !keep_frames) store.emplace(folder);
+  record.state = RunSolverStage(stage, dataset, options, in, progress, &section, &brief, &all_levels,
+                                store ? &*store : nullptr);
   const double seconds = start.Seconds();
   spdlog::info("{}", brief);
 
@@ -114,28 +121,29 @@ StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& 
   report["options"][StageSection(stage)] = OptionsOf(options, stage);
   report[StageSection(stage)] = section;
   report["timings_seconds"][StageSection(stage)] = seconds;
-  WriteStageFolder(folder, record, all_levels.empty() ? nullptr : &all_levels);
+  if (store)
+    FinishShapeStageFolder(folder, record, store->frames_fitted());
+  else
+    WriteStageFolder(folder, record, all_levels.empty() ? nullptr : &all_levels);
   return record;
 }
 
 void WriteReconstruction(const CommandRun& run, const vision::Dataset& dataset, const nlohmann::json& options_json,
-                         const StageRecord& last, const nlohmann::json& stages, const Stopwatch& since_start) {
-  const solver::StageState& state = last.state;
-  const Stopwatch split_start;
-  const solver::RigidSplit split = solver::RunSplitStage(state);
-  const double split_seconds = split_start.Seconds();
+                         const nlohmann::json& last_report, const StageFrames& last, const nlohmann::json& stages,
+                         const Stopwatch& since_start) {
   const Stopwatch write_start;
   nlohmann::json report = ReportHead(run, dataset);
   report["options"] = options_json;
   report["stages"] = stages;
   for (Stage stage : kStages)
-    if (last.report.contains(StageSection(stage))) report[StageSection(stage)] = last.report[StageSection(stage)];
-  report["rigid_motion"] = RigidMotionJson(split.rigid, state.first_frame);
-  report["flow"] = WriteSequence(run.out, state.Hierarchy(), state.first_frame, state.control, split);
-  WriteHullFiles(run.out, state.base_mesh, state.first_frame, state.hulls);
-  nlohmann::json timings = last.report.value("timings_seconds", nlohmann::json::object());
-  timings["rigid_split"] = split_seconds;
-  timings["writing"] = write_start.Seconds();
+    if (last_report.contains(StageSection(stage))) report[StageSection(stage)] = last_report[StageSection(stage)];
+  solver::RigidSplit split;
+  report["flow"] = WriteSequence(run.out, last, &split);
+  report["rigid_motion"] = RigidMotionJson(split.rigid, last.first_frame());
+  WriteHullFiles(run.out, last.BaseMesh(), last.first_frame(), {});  // base_mesh.ply (hull/: WriteSequence)
+  nlohmann::json timings = last_report.value("timings_seconds", nlohmann::json::object());
+  timings["rigid_split"] = split.seconds;
+  timings["writing"] = write_start.Seconds() - split.seconds;
   timings["total"] = since_start.Seconds();
   report["timings_seconds"] = timings;
   report["total_seconds"] = timings["total"];
@@ -197,7 +205,7 @@ nlohmann::json RunReconstruction(const CommandRun& run, const vision::Dataset& d
     }
     stages[StageName(stage)] = reuse ? "loaded" : "computed";
   }
-  WriteReconstruction(run, dataset, options, *last, stages, since_start);
+  WriteReconstruction(run, dataset, options, last->report, StateFrames(last->state), stages, since_start);
   return stages;
 }
 

@@ -15,6 +15,7 @@
 #include "core/stopwatch.h"
 #include "output/report.h"
 #include "output/stage_folder.h"
+#include "output/stage_frames.h"
 #include "solver/reconstruction.h"
 #include "vision/dataset.h"
 
@@ -35,16 +36,23 @@ nlohmann::json StageOptionsJson(const solver::ReconstructionOptions& options, so
 // its stage folder `folder` (which the caller prepared) and returns its record. The
 // report: the head of `run`, "stage", and, carried on from in's report and extended by
 // this stage, "options" (per stage section), each stage's figures and "timings_seconds".
+// Without `keep_frames` (the stage commands, which read the record no further), the shape
+// stage writes each frame's hull and fit into the folder as it makes them
+// (ShapeStageFolderStore) and the record's state holds no frames: its memory does not
+// grow with the take. The folder's files are the same either way.
 StageRecord RunStage(solver::Stage stage, const CommandRun& run, const vision::Dataset& dataset,
                      const solver::ReconstructionOptions& options, const StageRecord* in, const std::string& folder,
-                     Progress* progress = nullptr);
+                     Progress* progress = nullptr, bool keep_frames = true);
 
-// The OUTPUT.md result of the final stage's record in run.out (prepared by the caller):
-// the split (solver::RunSplitStage), meshes/, obj/, control/, hull/, base_mesh.ply and
-// report.json (head, `options_json`, every stage's figures from the record, rigid_motion,
-// flow, timings; `stages` says per stage whether it was computed or loaded).
+// The OUTPUT.md result of the final stage's frames and report in run.out (prepared by the
+// caller): the split and meshes/, obj/, control/, hull/ frame by frame (WriteSequence),
+// base_mesh.ply and report.json (head, `options_json`, every stage's figures from
+// `last_report`, rigid_motion, flow, timings; `stages` says per stage whether it was
+// computed or loaded). `subflow split` gives the frames of a stage folder
+// (StageFolderFrames), so its memory does not grow with the take.
 void WriteReconstruction(const CommandRun& run, const vision::Dataset& dataset, const nlohmann::json& options_json,
-                         const StageRecord& last, const nlohmann::json& stages, const Stopwatch& since_start);
+                         const nlohmann::json& last_report, const StageFrames& last, const nlohmann::json& stages,
+                         const Stopwatch& since_start);
 
 // `subflow reconstruct`: the stages of `options` one after another, each writing its
 // stage folder <run.out>/stages/<stage>/ as it finishes, then the result in run.out. With

@@ -79,11 +79,11 @@ namespace {
 
 // Per camera, the scale at which the finest level's edges of the reference frame's
 // surface project to about `edge_pixels` (vision::SurfaceScale; never enlarged).
-std::vector<double> WorkingImageScales(const vision::Dataset& dataset, const StageState& state, double edge_pixels) {
+std::vector<double> WorkingImageScales(const vision::Dataset& dataset, const geometry::LoopHierarchy& hierarchy,
+                                       const geometry::Positions& reference_control, double edge_pixels) {
   if (edge_pixels == 0) return {};
-  const geometry::LoopHierarchy& hierarchy = state.Hierarchy();
   const geometry::Faces& faces = hierarchy.LevelFaces(hierarchy.finest_level());
-  const geometry::Positions reference_surface = state.Surface(state.reference_index());
+  const geometry::Positions reference_surface = hierarchy.LimitPositions(hierarchy.finest_level()) * reference_control;
   std::vector<double> scales(dataset.camera_count());
   std::string line;
   for (int k = 0; k < dataset.camera_count(); ++k) {
@@ -98,8 +98,8 @@ std::vector<double> WorkingImageScales(const vision::Dataset& dataset, const Sta
 }  // namespace
 
 StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions& options, Progress* progress,
-                         ShapeInitResult* figures) {
-  *figures = InitializeShape(dataset, options, progress);
+                         ShapeInitResult* figures, ShapeFrameStore* store) {
+  *figures = InitializeShape(dataset, options, progress, store);
   StageState state;
   state.hierarchy = figures->hierarchy;
   state.base_mesh = figures->base_mesh;
@@ -107,11 +107,13 @@ StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions&
   state.reference_frame = figures->reference_frame;
   state.evidence = options.silhouettes.source;
   const int finest = state.hierarchy->finest_level();
-  for (const FrameShapeInit& frame : figures->frames) {
-    state.hulls.push_back(frame.hull);
-    state.control.push_back(frame.control.at(finest));
-  }
-  state.image_scales = WorkingImageScales(dataset, state, options.image_edge_pixels);
+  if (!store)
+    for (FrameShapeInit& frame : figures->frames) {
+      state.hulls.push_back(std::move(frame.hull));  // moved: the figures keep its size
+      state.control.push_back(frame.control.at(finest));
+    }
+  state.image_scales =
+      WorkingImageScales(dataset, state.Hierarchy(), figures->reference_control, options.image_edge_pixels);
   return state;
 }
 

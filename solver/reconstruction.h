@@ -90,8 +90,11 @@ vision::ImageSequence StageImages(const vision::Dataset& dataset, const StageSta
 
 // The stages. Each returns the state the next one reads and keeps its figures in
 // *figures (for report.json).
+// The shape stage: with `store` (InitializeShape), the hulls and control points go there
+// and the returned state holds none (hulls and control empty; the `shape` command writes
+// its stage folder so); without, they are moved from *figures into the state.
 StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions& options, Progress* progress,
-                         ShapeInitResult* figures);
+                         ShapeInitResult* figures, ShapeFrameStore* store = nullptr);
 // Motion initialization from the reference frame's control points, each frame corrected
 // towards its own (the shape stage's fit, or, for the retrack pass, the refined shapes).
 StageState RunMotionStage(const vision::Dataset& dataset, const StageState& in, const MotionInitOptions& options,

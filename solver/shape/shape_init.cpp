@@ -16,13 +16,29 @@
 namespace subflow::solver {
 namespace {
 
+// The store without a ShapeFrameStore: the hulls and control points in the result's frames.
+class FramesStore : public ShapeFrameStore {
+ public:
+  FramesStore(std::vector<FrameShapeInit>* frames, int first) : frames_(frames), first_(first) {}
+  void StoreHull(int frame, const geometry::TriangleMesh& hull) override { At(frame).hull = hull; }
+  geometry::TriangleMesh LoadHull(int frame) const override { return frames_->at(frame - first_).hull; }
+  void StoreControl(int frame, const geometry::LoopHierarchy&, const std::vector<geometry::Positions>& levels) override {
+    At(frame).control = levels;
+  }
+
+ private:
+  FrameShapeInit& At(int frame) { return frames_->at(frame - first_); }
+  std::vector<FrameShapeInit>* frames_;
+  int first_;
+};
+
 // Frames without evidence take the hull and carving figures of the nearest frame with
 // evidence (the earlier one on a tie), with a warning; an error when no frame has any.
 // all_empty[i]: every silhouette of frame i is empty and none is motion evidence (the
 // object has left the volume).
 void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std::vector<bool>& has_evidence,
                                       const std::vector<bool>& all_empty, int min_cameras,
-                                      std::vector<FrameShapeInit>* frames) {
+                                      std::vector<FrameShapeInit>* frames, ShapeFrameStore* store) {
   const int count = static_cast<int>(frames->size());
   const std::string frame_range =
       "frames " + std::to_string(frames->front().frame) + ".." + std::to_string(frames->back().frame);
@@ -47,7 +63,9 @@ void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std:
     frame.carving.frame = frame.frame;
     frame.carving.warnings.clear();
     frame.isosurface = taken.isosurface;
-    frame.hull = taken.hull;
+    store->StoreHull(frame.frame, store->LoadHull(taken.frame));
+    frame.hull_vertices = taken.hull_vertices;
+    frame.hull_faces = taken.hull_faces;
     const std::string warning = all_empty[i] ?
         "frame " + std::to_string(frame.frame) + ": every camera's silhouette is empty (the object has left the "
         "working volume): hull of frame " + std::to_string(taken.frame) + " used" :
@@ -73,7 +91,7 @@ struct HullStage {
 
   void Run(const vision::SilhouetteOptions& silhouette_options, const std::vector<vision::Silhouette>* still,
            Progress* progress, std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
-           std::vector<bool>* all_empty) const {
+           std::vector<bool>* all_empty, ShapeFrameStore* store) const {
     const int count = static_cast<int>(frames->size());
     ProgressBegin(progress, "visual hull", count);
     for (int i = 0; i < count; ++i) {
@@ -96,9 +114,12 @@ struct HullStage {
         frame.carving = vision::CarveVoxels(cameras, silhouettes, dataset.bounds(), carving, frame.frame);
         frame.carve_seconds = start.Seconds();
         start.Restart();
-        frame.hull = geometry::ExtractIsosurface(frame.carving.occupancy, isosurface, &frame.isosurface,
-                                                 "occupancy of frame " + vision::FrameName(frame.frame));
+        const geometry::TriangleMesh hull = geometry::ExtractIsosurface(
+            frame.carving.occupancy, isosurface, &frame.isosurface, "occupancy of frame " + vision::FrameName(frame.frame));
         frame.isosurface_seconds = start.Seconds();
+        frame.hull_vertices = hull.vertex_count();
+        frame.hull_faces = hull.face_count();
+        store->StoreHull(frame.frame, hull);
         frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
       }
       ProgressUpdate(progress, i + 1);
@@ -142,6 +163,46 @@ std::vector<vision::Silhouette> StillSilhouettes(const vision::Dataset& dataset,
   return silhouettes;
 }
 
+// Fits the hierarchy to every frame's hull (FrameShapeInit::fit and fit_seconds; the
+// control points of levels 0..n to `store`), outwards from the reference frame. A frame
+// starts from its neighbour's fitted base, the frame fitted last on its side of the
+// reference frame: only those two bases are kept. Returns the reference frame's finest
+// control points.
+geometry::Positions FitEveryFrame(const HierarchyFitOptions& options, ShapeFrameStore* store, Progress* progress,
+                                  ShapeInitResult* result) {
+  const int count = static_cast<int>(result->frames.size());
+  const int reference_index = result->reference_frame - result->frames.front().frame;
+  ProgressBegin(progress, "fit subdivision surface", count);
+  std::vector<int> order{reference_index};
+  for (int d = 1; d < count; ++d) {
+    if (reference_index - d >= 0) order.push_back(reference_index - d);
+    if (reference_index + d < count) order.push_back(reference_index + d);
+  }
+  int done = 0;
+  geometry::Positions base_before, base_after, reference_control;  // sides i < and i > reference_index
+  for (int i : order) {
+    FrameShapeInit& frame = result->frames[i];
+    const Stopwatch start;
+    const geometry::Positions& initial_base =
+        i == reference_index ? result->base_mesh.V : (i < reference_index ? base_before : base_after);
+    const geometry::ClosestPointTree hull_tree(store->LoadHull(frame.frame),
+                                               "visual hull of frame " + vision::FrameName(frame.frame));
+    const std::vector<geometry::Positions> control =
+        FitHierarchyToSurface(*result->hierarchy, initial_base, hull_tree, options, &frame.fit);
+    frame.fit_seconds = start.Seconds();
+    if (i == reference_index) {
+      base_before = base_after = control.front();
+      reference_control = control.back();
+    } else {
+      (i < reference_index ? base_before : base_after) = control.front();
+    }
+    store->StoreControl(frame.frame, *result->hierarchy, control);
+    ProgressUpdate(progress, ++done);
+  }
+  ProgressEnd(progress);
+  return reference_control;
+}
+
 }  // namespace
 
 std::string ShapeInitResult::BriefReport() const {
@@ -181,7 +242,7 @@ void ShapeInitOptions::Check() const {
 }
 
 ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitOptions& options,
-                                Progress* progress) {
+                                Progress* progress, ShapeFrameStore* store) {
   options.Check();
   const int available = dataset.frame_count() - options.first_frame;
   if (available <= 0)
@@ -200,6 +261,8 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   result.reference_frame = reference;
   result.frames.resize(count);
   for (int i = 0; i < count; ++i) result.frames[i].frame = result.frames[i].hull_from_frame = first + i;
+  FramesStore in_frames(&result.frames, first);
+  if (!store) store = &in_frames;
 
   // Evidence on images reduced to what the voxel grid resolves (vision/working_scale.h),
   // the grid's resolution fixed first so that it does not follow the reduced cameras.
@@ -236,12 +299,12 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   std::vector<vision::Silhouette> still;
   if (still_forced) still = StillSilhouettes(dataset, reference, evidence_cameras, carving.resolution, options, &result);
   stage.Run(options.silhouettes, still_forced ? &still : nullptr, progress, &result.frames, &has_evidence,
-            &all_empty);
+            &all_empty, store);
   const bool none = std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end();
   if (!still_forced && none && options.still.enabled && options.silhouettes.source == vision::EvidenceSource::kAuto &&
       std::find(all_empty.begin(), all_empty.end(), false) != all_empty.end()) {
     still = StillSilhouettes(dataset, reference, evidence_cameras, carving.resolution, options, &result);
-    stage.Run(options.silhouettes, &still, progress, &result.frames, &has_evidence, &all_empty);
+    stage.Run(options.silhouettes, &still, progress, &result.frames, &has_evidence, &all_empty, store);
   }
   for (vision::EstimatedBackground& estimated : result.estimated_backgrounds)  // memory: keep the figures
     estimated.image.release(), estimated.known.release(), estimated.instability.release();
@@ -251,12 +314,12 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     ThrowError(dataset.directory(), "evidence",
                "no masks, no background, nothing moves, and the photo-consistency of the still set (evidence "
                "\"still\") found no surface either: cannot find the object (give masks or background images)");
-  TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames);
+  TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames,
+                                   store);
 
   // Base mesh and hierarchy from the reference frame.
   Stopwatch start;
-  const FrameShapeInit& reference_frame = result.frames[reference - first];
-  result.resolution = ChooseBaseResolution(reference_frame.hull, dataset.cameras(), voxel_size, options,
+  result.resolution = ChooseBaseResolution(store->LoadHull(reference), dataset.cameras(), voxel_size, options,
                                            "visual hull of frame " + vision::FrameName(reference));
   result.base_mesh = std::move(result.resolution.base);
   result.simplify = result.resolution.simplify;
@@ -268,29 +331,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
                result.base_mesh.vertex_count(), result.base_mesh.face_count(), levels,
                result.hierarchy->FaceCount(levels));
 
-  // Fit the hierarchy to every frame's hull, outwards from the reference frame.
-  ProgressBegin(progress, "fit subdivision surface", count);
-  std::vector<int> order{reference - first};
-  for (int d = 1; d < count; ++d) {
-    if (reference - first - d >= 0) order.push_back(reference - first - d);
-    if (reference - first + d < count) order.push_back(reference - first + d);
-  }
-  int done = 0;
-  for (int i : order) {
-    FrameShapeInit& frame = result.frames[i];
-    start.Restart();
-    const int neighbour = i < reference - first ? i + 1 : i - 1;
-    const geometry::Positions& initial_base =
-        i == reference - first ? result.base_mesh.V : result.frames[neighbour].control.front();
-    const geometry::ClosestPointTree hull_tree(frame.hull, "visual hull of frame " +
-                                                               vision::FrameName(frame.frame));
-    frame.control = FitHierarchyToSurface(*result.hierarchy, initial_base, hull_tree,
-                                          options.fit, &frame.fit);
-    frame.shape = geometry::MultiresShape::Analyze(*result.hierarchy, frame.control.back());
-    frame.fit_seconds = start.Seconds();
-    ProgressUpdate(progress, ++done);
-  }
-  ProgressEnd(progress);
+  result.reference_control = FitEveryFrame(options.fit, store, progress, &result);
   return result;
 }
 

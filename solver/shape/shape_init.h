@@ -10,7 +10,8 @@
 //                 → LoopHierarchy of T0 with that many levels
 //   every frame:  control points of levels 0..n fitted to H_f along limit normals
 //                 (solver/shape/hierarchy_fit.h), frames visited outwards from r so that each
-//                 starts from its neighbour's fitted base; MultiresShape by analysis.
+//                 starts from its neighbour's fitted base (the multires analysis of a frame, when
+//                 needed, is geometry::MultiresShape::Analyze of its finest control points).
 //
 // Snapping along normals only moves points across the surface: vertices of different
 // frames correspond only approximately (tangential drift). Motion initialization
@@ -96,15 +97,32 @@ struct FrameShapeInit {
   int hull_from_frame = 0;
   vision::CarvingResult carving;             // figures; its occupancy volume is released
   geometry::IsosurfaceSummary isosurface;
-  geometry::TriangleMesh hull;               // the visual-hull iso-surface H_f
-  std::vector<geometry::Positions> control;  // fitted control points, levels 0..n
+  geometry::TriangleMesh hull;               // the visual-hull iso-surface H_f (empty with a ShapeFrameStore)
+  int hull_vertices = 0, hull_faces = 0;     // the hull's size (with or without a store)
+  std::vector<geometry::Positions> control;  // fitted control points, levels 0..n (empty with a store)
   std::vector<LevelFitSummary> fit;          // per level
-  geometry::MultiresShape shape;             // analysis of control.back()
   double carve_seconds = 0, isosurface_seconds = 0, fit_seconds = 0;
+};
+
+// Where InitializeShape keeps each frame's visual hull and fitted control points. Without
+// one (nullptr) they stay in FrameShapeInit::hull and ::control. The `shape` command gives
+// one that writes them into its stage folder as they are made and reads a hull back when
+// it is needed again (the reference frame's for the base mesh, each frame's for its fit),
+// so that the stage's memory does not grow with the take's length (docs/cluster.md).
+// LoadHull must return exactly what StoreHull was given.
+class ShapeFrameStore {
+ public:
+  virtual ~ShapeFrameStore() = default;
+  virtual void StoreHull(int frame, const geometry::TriangleMesh& hull) = 0;
+  virtual geometry::TriangleMesh LoadHull(int frame) const = 0;
+  // `levels`: the frame's control points of levels 0..n of `hierarchy`.
+  virtual void StoreControl(int frame, const geometry::LoopHierarchy& hierarchy,
+                            const std::vector<geometry::Positions>& levels) = 0;
 };
 
 struct ShapeInitResult {
   int reference_frame = 0;
+  geometry::Positions reference_control;  // the reference frame's finest fitted control points
   geometry::TriangleMesh base_mesh;  // T0 (level 0 at the reference frame, before fitting)
   geometry::SimplifySummary simplify;
   // How T0 and the levels were chosen (base_resolution.h; its `base` is moved to base_mesh).
@@ -135,7 +153,9 @@ struct ShapeInitResult {
 // vision/geometry stages), and when no frame has any evidence of the object; warnings
 // (cameras excluded, object touching the bounds, a frame without evidence) are logged
 // and kept in each frame's carving result.
+// With `store`, the hulls and control points go there (see ShapeFrameStore), not into
+// the frames of the result; the results are the same.
 ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitOptions& options,
-                                Progress* progress = nullptr);
+                                Progress* progress = nullptr, ShapeFrameStore* store = nullptr);
 
 }  // namespace subflow::solver

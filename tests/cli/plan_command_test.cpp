@@ -2,8 +2,10 @@
 // synthetic take in 3 chunks: the plan's tasks and dependencies, the chained motion
 // chunks that continue each other's trajectories (vertex i is one material point across
 // chunk boundaries), the merged result against the single-process `reconstruct`, a killed
-// task re-run alone giving the same result, and the sbatch scripts.
+// task re-run alone giving the same result, the sbatch scripts, and planning again into
+// a plan's folder (task stamps: only what a changed option defines runs again).
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -144,6 +146,52 @@ void AKilledTaskRerunsAloneAndGivesTheSameResult() {
   EXPECT_NE(run.output().find("run-plan: refine_1 ("), std::string::npos) << run.output();
   int i = 0;
   for (const char* frame : {"000000", "000005", "000011"}) EXPECT_EQ(mesh(frame), before[i++]) << frame;
+}
+
+// The ids of the tasks a run-plan ran (not those it skipped as finished), from its log.
+std::set<std::string> TasksRun(const test::CommandResult& run, const nlohmann::json& plan) {
+  std::set<std::string> ran;
+  for (const auto& task : plan["tasks"])
+    if (run.output().find("run-plan: " + task["id"].get<std::string>() + " (") != std::string::npos)
+      ran.insert(task["id"].get<std::string>());
+  return ran;
+}
+
+// Planning again into a plan's folder: the same options change nothing (no task runs
+// again); another refinement option is refused without --overwrite, naming the folder and
+// the tasks it changes, and with --overwrite exactly the refinement tasks and those
+// downstream of them run again, the shape and motion tasks' results are kept.
+TEST(PlanCommand, PlanningAgainRerunsExactlyTheTasksItChanges) {
+  const fs::path dir = Scratch().FreshPath("replan");
+  const std::string plan = "plan " + Quoted(Dataset()) + " --out " + Quoted(dir) + " --frames 0:8 --chunk 4 --overlap 1";
+  RunOk(plan + kOptions);
+  const nlohmann::json first = ReadJson(dir / "plan.json");
+  EXPECT_EQ(TasksRun(RunOk("run-plan " + Quoted(dir)), first).size(), first["tasks"].size());
+
+  RunOk(plan + kOptions);  // the same plan: allowed without --overwrite, and nothing to do
+  EXPECT_EQ(ReadJson(dir / "plan.json")["tasks"], first["tasks"]);
+  const test::CommandResult again = RunOk("run-plan " + Quoted(dir));
+  EXPECT_TRUE(TasksRun(again, first).empty()) << again.output();
+
+  const std::string changed = " --base-faces 120 --levels 2 --window 3 --iterations 3 ";  // refinement's
+  const test::CommandResult refused = RunSubflow(plan + changed, Scratch().path());
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output().find(dir.string()), std::string::npos) << refused.output();
+  EXPECT_NE(refused.output().find("differs from this one (tasks defined otherwise: refine_0, refine_1, refine_merge"),
+            std::string::npos)
+      << refused.output();
+  EXPECT_NE(refused.output().find("--overwrite"), std::string::npos) << refused.output();
+  EXPECT_EQ(ReadJson(dir / "plan.json")["tasks"], first["tasks"]);  // untouched
+
+  RunOk(plan + changed + "--overwrite");
+  const nlohmann::json second = ReadJson(dir / "plan.json");
+  const test::CommandResult rerun = RunOk("run-plan " + Quoted(dir));
+  const std::set<std::string> expected = {"refine_0", "refine_1", "refine_merge", "retrack_0",
+                                          "retrack_1", "retrack_merge", "split"};
+  EXPECT_EQ(TasksRun(rerun, second), expected) << rerun.output();
+  EXPECT_EQ(ReadJson(dir / "refine_0" / "report.json")["options"]["refinement"]["solver"]["max_iterations"], 3);
+  EXPECT_EQ(ReadJson(dir / "result" / "report.json")["options"]["refinement"]["solver"]["max_iterations"], 3);
+  EXPECT_TRUE(TasksRun(RunOk("run-plan " + Quoted(dir)), second).empty());
 }
 
 void SlurmScriptsUseAnArrayAndAfterokDependencies() {

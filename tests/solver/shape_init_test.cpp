@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -376,6 +377,56 @@ TEST(ShapeInitBadInput, NoMasksNoBackgroundNoMotionAndNoPhotoConsistencyIsAnErro
               std::string::npos)
         << error.what();
   }
+}
+
+// A ShapeFrameStore that keeps what it is given and counts the hulls read back.
+class RecordingStore : public ShapeFrameStore {
+ public:
+  void StoreHull(int frame, const geometry::TriangleMesh& hull) override { hulls[frame] = hull; }
+  geometry::TriangleMesh LoadHull(int frame) const override {
+    ++loads[frame];
+    return hulls.at(frame);
+  }
+  void StoreControl(int frame, const geometry::LoopHierarchy&, const std::vector<geometry::Positions>& levels) override {
+    EXPECT_EQ(control.count(frame), 0u) << "frame " << frame << " fitted twice";
+    control[frame] = levels;
+  }
+  std::map<int, geometry::TriangleMesh> hulls;
+  std::map<int, std::vector<geometry::Positions>> control;
+  mutable std::map<int, int> loads;
+};
+
+// With a store (what the `shape` command gives to keep its memory independent of the
+// take's length), every frame's hull and fit go to the store and none stays in the
+// result, whose figures still give the hulls' sizes; the values are exactly those of the
+// run without a store (the same frames fitted from the same neighbours, outwards from the
+// reference frame, which only the two last fitted bases make possible); each hull is read
+// back once for its fit, the reference frame's once more for the base mesh.
+TEST(ShapeInit, AFrameStoreReceivesEveryHullAndFitWithTheSameValues) {
+  const fs::path directory = Scratch().FreshPath("store");
+  vision::WriteSyntheticDataset(directory.string(), SphereOptions("dome", 6, 160, 120, 5));
+  const vision::Dataset dataset(directory.string());
+  const ShapeInitResult in_memory = InitializeShape(dataset, QuickOptions());
+  RecordingStore store;
+  const ShapeInitResult stored = InitializeShape(dataset, QuickOptions(), nullptr, &store);
+  ASSERT_EQ(stored.frames.size(), 5u);
+  ASSERT_EQ(in_memory.frames.size(), 5u);
+  EXPECT_EQ(stored.reference_frame, 2);
+  for (std::size_t i = 0; i < stored.frames.size(); ++i) {
+    const FrameShapeInit& frame = stored.frames[i];
+    const FrameShapeInit& expected = in_memory.frames[i];
+    EXPECT_EQ(frame.hull.vertex_count(), 0) << "frame " << frame.frame;
+    EXPECT_TRUE(frame.control.empty()) << "frame " << frame.frame;
+    ASSERT_EQ(store.hulls.count(frame.frame), 1u);
+    EXPECT_EQ(store.hulls[frame.frame].V, expected.hull.V) << "frame " << frame.frame;
+    EXPECT_EQ(store.hulls[frame.frame].F, expected.hull.F) << "frame " << frame.frame;
+    EXPECT_EQ(frame.hull_vertices, expected.hull.vertex_count());
+    EXPECT_EQ(frame.hull_faces, expected.hull.face_count());
+    EXPECT_EQ(store.control[frame.frame], expected.control) << "frame " << frame.frame;
+    EXPECT_EQ(store.loads[frame.frame], frame.frame == stored.reference_frame ? 2 : 1) << "frame " << frame.frame;
+  }
+  EXPECT_EQ(stored.base_mesh.F, in_memory.base_mesh.F);
+  EXPECT_EQ(stored.reference_control, in_memory.frames[2].control.back());
 }
 
 }  // namespace
