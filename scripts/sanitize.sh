@@ -3,15 +3,17 @@
 # -O1 -g1: line tables for the reports' stack traces, a third less compile time than
 # -O2 -g; no benchmarks) and runs them: any report fails the run (halt_on_error /
 # abort_on_error, leaks included).
-# Which tests: SUBFLOW_SANITIZE_FOLDERS, default "all" (every test, the command tests with
-# an instrumented `subflow`); or some of the test folders (CTest labels, see
-# tests/CMakeLists.txt), e.g. "core geometry vision" for the readers and file mechanisms
-# alone, which need only those three libraries built.
+# Which tests: SUBFLOW_SANITIZE_FOLDERS, default "core geometry vision" (the test folders =
+# CTest labels, see tests/CMakeLists.txt: the readers, writers and file mechanisms every
+# input passes through, which need only those three libraries built); "all" builds and runs
+# every test, the command tests with an instrumented `subflow` (on a fresh clone with 2
+# cores: 391/391 passed with zero reports; build 21.5 min + run 17 min, which next to the
+# Release build and tests does not fit CI's 45 minutes yet).
 # Tests matching SUBFLOW_SANITIZE_EXCLUDE (a ctest -E regex) are left out.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="$root/build-asan"
-folders="${SUBFLOW_SANITIZE_FOLDERS:-all}"
+folders="${SUBFLOW_SANITIZE_FOLDERS:-core geometry vision}"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
   -DSUBFLOW_SANITIZE=ON \
   -DSUBFLOW_BUILD_BENCHMARKS=OFF ${CMAKE_CXX_COMPILER_LAUNCHER:+-DCMAKE_CXX_COMPILER_LAUNCHER=$CMAKE_CXX_COMPILER_LAUNCHER}
