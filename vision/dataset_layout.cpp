@@ -28,10 +28,16 @@ std::string SizeText(int width, int height) {
   return std::to_string(width) + "×" + std::to_string(height);
 }
 
-std::string CameraList(const std::vector<Camera>& cameras) {
+std::string JoinedNames(const std::vector<std::string>& names) {
   std::string list;
-  for (const Camera& camera : cameras) list += (list.empty() ? "" : ", ") + camera.name();
+  for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
   return list;
+}
+
+std::string CameraList(const std::vector<Camera>& cameras) {
+  std::vector<std::string> names;
+  for (const Camera& camera : cameras) names.push_back(camera.name());
+  return JoinedNames(names);
 }
 
 // Frame index of "<6 digits><extension>", or -1.
@@ -109,25 +115,18 @@ std::vector<std::string> PixelFormatWarnings(const DatasetLayout& layout,
   }
   if (cameras_of.size() > 1) {
     std::string list;
-    for (const auto& [format, names] : cameras_of) {
-      std::string joined;
-      for (const std::string& name : names) joined += (joined.empty() ? "" : ", ") + name;
-      list += (list.empty() ? "" : "; ") + format.Text() + ": " + joined;
-    }
+    for (const auto& [format, names] : cameras_of)
+      list += (list.empty() ? "" : "; ") + format.Text() + ": " + JoinedNames(names);
     warnings.push_back("cameras' images differ in pixel format (" + list +
                        "): each is read as a gray intensity in [0, 1] (8-bit / 255, 16-bit / 65535)");
   }
-  std::string sixteen_bit;
-  int sixteen_bit_count = 0;
-  for (std::size_t c = 0; c < formats.size(); ++c) {
-    const bool any = std::any_of(formats[c].begin(), formats[c].end(),
-                                 [](const auto& entry) { return entry.first.bit_depth == 16; });
-    if (!any) continue;
-    sixteen_bit += (sixteen_bit.empty() ? "" : ", ") + layout.cameras[c].name();
-    ++sixteen_bit_count;
-  }
-  if (sixteen_bit_count > 0)
-    warnings.push_back("16-bit images (camera" + std::string(sixteen_bit_count > 1 ? "s " : " ") + sixteen_bit +
+  std::vector<std::string> sixteen_bit;  // cameras with any 16-bit frame
+  for (std::size_t c = 0; c < formats.size(); ++c)
+    if (std::any_of(formats[c].begin(), formats[c].end(), [](const auto& entry) { return entry.first.bit_depth == 16; }))
+      sixteen_bit.push_back(layout.cameras[c].name());
+  if (!sixteen_bit.empty())
+    warnings.push_back("16-bit images (camera" + std::string(sixteen_bit.size() > 1 ? "s " : " ") +
+                       JoinedNames(sixteen_bit) +
                        ") are read as value / 65535: data of fewer bits in the low bits (10- or 12-bit sensors) "
                        "then reads dark, so scale such data to the full 16-bit range first");
   return warnings;

@@ -28,6 +28,15 @@ const MotionTestScene& Scene() {
   return scene;
 }
 
+// Frames 0..frame_count−1 of vision's "rigid" scene on the test scene's mesh (subdivisions 4).
+vision::SyntheticScene RigidSequence(int frame_count) {
+  vision::SyntheticSceneOptions options;
+  options.scene = "rigid";
+  options.frame_count = frame_count;
+  options.subdivisions = 4;
+  return vision::MakeSyntheticScene(options);
+}
+
 // Mean |u_est − u_true| / mean |u_true| over the samples that at least two cameras see
 // (elsewhere only the smoothness term speaks).
 double SampleMotionError(const MotionStepEstimator& estimator, const Positions& control,
@@ -104,11 +113,7 @@ TEST(MotionStep, RecoversAKnownSmallRotation) {
 // that is not rigid).
 TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
   const MotionTestScene& scene = Scene();
-  vision::SyntheticSceneOptions options;
-  options.scene = "rigid";
-  options.frame_count = 3;
-  options.subdivisions = 4;
-  const vision::SyntheticScene sequence = vision::MakeSyntheticScene(options);
+  const vision::SyntheticScene sequence = RigidSequence(3);
   ASSERT_LT((sequence.frames[0] - scene.mesh.V).cwiseAbs().maxCoeff(), 1e-12);
   std::vector<std::vector<cv::Mat>> images;
   std::vector<RigidMotion> truth;
@@ -169,11 +174,7 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
 // flagged and moves the surface by about the true step.
 TEST(MotionInit, FlagsADuplicatedFrameAndKeepsTheSurfaceStill) {
   const MotionTestScene& scene = Scene();
-  vision::SyntheticSceneOptions options;
-  options.scene = "rigid";
-  options.frame_count = 2;
-  options.subdivisions = 4;
-  const vision::SyntheticScene sequence = vision::MakeSyntheticScene(options);
+  const vision::SyntheticScene sequence = RigidSequence(2);
   const std::vector<cv::Mat> first = testing::RenderGray(scene, sequence.frames[0]);
   const std::vector<cv::Mat> second = testing::RenderGray(scene, sequence.frames[1]);
   const vision::ImageSequence images{scene.cameras, 0, 3, [&](int camera, int frame) {
