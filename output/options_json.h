@@ -121,7 +121,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(NormalFlowSolverOptions, smoothness, rigid_invariant_smoothness,
                                    detail_damping, coarsest_level, finest_level, min_samples_per_face,
                                    reweighting_iterations, robust_threshold, noise_floor, collinearity_pruning,
-                                   collinearity_min_cameras, cg_tolerance, cg_max_iterations)
+                                   collinearity_min_cameras, cg_tolerance, cg_reweighting_tolerance,
+                                   cg_max_iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solver, image_sigmas)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(WindowSolverOptions, linear_solver, max_iterations, threads, function_tolerance)

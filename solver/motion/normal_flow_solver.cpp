@@ -88,6 +88,9 @@ void NormalFlowSolverOptions::Check() const {
                "expected ≥ 3 (two planes always intersect in a line)");
   if (!std::isfinite(cg_tolerance) || cg_tolerance <= 0.0 || cg_tolerance >= 1.0)
     ThrowError("normal flow solver", "cg_tolerance", "expected a value in (0, 1)");
+  if (!std::isfinite(cg_reweighting_tolerance) || cg_reweighting_tolerance <= 0.0 ||
+      cg_reweighting_tolerance >= 1.0)
+    ThrowError("normal flow solver", "cg_reweighting_tolerance", "expected a value in (0, 1)");
   if (!std::isfinite(min_samples_per_face) || min_samples_per_face < 0.0)
     ThrowError("normal flow solver", "min_samples_per_face", "expected a finite value ≥ 0");
   if (cg_max_iterations < 1)
@@ -271,7 +274,7 @@ std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
 void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
                                    const Eigen::VectorXd& weights,
                                    const std::vector<Positions>& rigid_part,
-                                   NormalFlowSolution* solution,
+                                   double cg_tolerance, NormalFlowSolution* solution,
                                    Positions* sample_motion_out) const {
   const int samples = static_cast<int>(limit_.rows());
   const int vertices = static_cast<int>(limit_.cols());
@@ -353,7 +356,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       const Sparse A = AssembleLevelMatrix(level_matrix_[level], data[level], report.data_stiffness);
       Eigen::VectorXd solution_vector = x;
       const ConjugateGradientResult cg = SolveConjugateGradient(
-          A, rhs, options_.cg_tolerance, options_.cg_max_iterations, &solution_vector);
+          A, rhs, cg_tolerance, options_.cg_max_iterations, &solution_vector);
       x = solution_vector;
       report.cg_iterations = cg.iterations;
       report.cg_error = cg.relative_residual;
@@ -399,10 +402,12 @@ NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constrai
   Positions previous = warm_start ? warm_start->displacement : Positions();
   Positions sample_motion;
   for (int pass = 0; pass <= options_.reweighting_iterations; ++pass) {
-    SolveLevels(constraints, weights, RigidPart(control, previous), &solution, &sample_motion);
+    const bool last = pass == options_.reweighting_iterations;
+    SolveLevels(constraints, weights, RigidPart(control, previous),
+                last ? options_.cg_tolerance : options_.cg_reweighting_tolerance, &solution, &sample_motion);
     previous = solution.displacement;
     residual = constraints.Residuals(sample_motion);
-    if (pass == options_.reweighting_iterations) break;
+    if (last) break;
     std::vector<double> active;
     for (int c = 0; c < constraints.size(); ++c)
       if (solution.collinearity_weights(c) > 0.0) active.push_back(residual(c));
