@@ -127,7 +127,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solv
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(WindowSolverOptions, linear_solver, max_iterations, threads, function_tolerance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
-                                   per_patch_levels,
+                                   per_patch_levels, detail_threshold, min_detail_patch_area,
                                    normal_only_from_level, window, window_overlap, rounds, solver,
                                    samples_per_pixel, min_density, max_density, max_cameras, min_samples,
                                    image_sigma, ncc_epsilon, ncc_loss_scale, temporal_weight, silhouette_weight,

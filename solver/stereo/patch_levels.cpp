@@ -10,8 +10,11 @@
 namespace subflow::solver {
 
 PatchLevels::PatchLevels(const geometry::LoopHierarchy& hierarchy, const geometry::Positions& finest_control,
-                         const std::vector<vision::Camera>& cameras, double min_patch_area, bool per_patch_levels)
-    : min_area_(min_patch_area), per_patch_(per_patch_levels) {
+                         const std::vector<vision::Camera>& cameras, double min_patch_area, bool per_patch_levels,
+                         double min_detail_patch_area)
+    : min_area_(min_patch_area),
+      min_detail_area_(min_detail_patch_area > 0.0 ? std::min(min_detail_patch_area, min_patch_area) : min_patch_area),
+      per_patch_(per_patch_levels) {
   const geometry::Positions base = geometry::MultiresShape::Analyze(hierarchy, finest_control).base();
   const geometry::Positions corners = hierarchy.LimitPositions(0) * base;
   const geometry::Faces& F = hierarchy.LevelFaces(0);
@@ -31,19 +34,26 @@ PatchLevels::PatchLevels(const geometry::LoopHierarchy& hierarchy, const geometr
     if (area > 0.0) seen.push_back(area);
   if (seen.empty()) return;
   std::nth_element(seen.begin(), seen.begin() + seen.size() / 2, seen.end());
-  const auto deepest = [&](double area) {
+  const auto deepest = [&](double area, double floor) {
     int level = 0;
-    while (level < hierarchy.finest_level() && area / 4.0 >= min_patch_area) area /= 4.0, ++level;
+    while (level < hierarchy.finest_level() && area / 4.0 >= floor) area /= 4.0, ++level;
     return level;
   };
-  median_level_ = deepest(seen[seen.size() / 2]);
-  finest_level_ = per_patch_ ? deepest(*std::max_element(seen.begin(), seen.end())) : median_level_;
+  median_level_ = deepest(seen[seen.size() / 2], min_area_);
+  finest_level_ =
+      per_patch_ ? deepest(*std::max_element(seen.begin(), seen.end()), min_detail_area_) : median_level_;
 }
 
 bool PatchLevels::Resolved(int level, int face) const {
   if (level <= median_level_) return true;
   if (!per_patch_ || level > finest_level_) return false;
-  return std::ldexp(base_area_.at(face >> (2 * level)), -2 * level) >= min_area_;
+  return Area(level, face) >= min_area_;
+}
+
+bool PatchLevels::ResolvedForDetail(int level, int face) const {
+  if (level <= median_level_) return true;
+  if (!per_patch_ || level > finest_level_) return false;
+  return Area(level, face) >= min_detail_area_;
 }
 
 }  // namespace subflow::solver

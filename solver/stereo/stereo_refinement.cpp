@@ -115,10 +115,11 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
     }
   }
   double moved_sum = 0.0;
-  std::vector<char> moved_vertices(moved.size(), 0);
+  std::vector<char> moved_vertices(moved.size(), 0);  // 0: still, 1: moved, 2: moved a lot
   for (std::size_t v = 0; v < moved.size(); ++v) {
     moved_sum += moved[v];
-    moved_vertices[v] = moved[v] > options.adaptive_threshold * prepared.h ? 1 : 0;
+    if (moved[v] > options.adaptive_threshold * prepared.h) moved_vertices[v] = 1;
+    if (options.detail_threshold > 0.0 && moved[v] > options.detail_threshold * prepared.h) moved_vertices[v] = 2;
   }
   report.mean_increment = moved_sum / static_cast<double>(moved.size());
   report.seconds = start.Seconds();
@@ -192,6 +193,8 @@ void StereoRefinementOptions::Check() const {
               temporal_smoothness >= 0 && damping >= 0,
           "weights", "must be ≥ 0");
   require(min_patch_area > 0, "min_patch_area", "must be > 0 (pixels²)");
+  require(detail_threshold >= 0, "detail_threshold", "must be ≥ 0 (edge lengths; 0 = off)");
+  require(min_detail_patch_area > 0, "min_detail_patch_area", "must be > 0 (pixels²)");
   require(angle_weight_power >= 0, "angle_weight_power", "must be ≥ 0");
   require(outline_margin >= 0, "outline_margin", "must be ≥ 0 (pixels)");
   require(max_step > 0, "max_step", "must be > 0");
@@ -218,7 +221,8 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
                  "must have #V(finest) = " + std::to_string(hierarchy.VertexCount(hierarchy.finest_level())) +
                      " finite rows");
   const PatchLevels patch_levels(hierarchy, control[control.size() / 2], images.cameras, options.min_patch_area,
-                                 options.per_patch_levels && options.finest_level < 0);
+                                 options.per_patch_levels && options.finest_level < 0,
+                                 options.detail_threshold > 0.0 ? options.min_detail_patch_area : 0.0);
   const int finest_refined = options.finest_level >= 0 ? options.finest_level : patch_levels.finest_level();
   if (finest_refined > hierarchy.finest_level() || options.coarsest_level > finest_refined)
     ThrowError("stereo refinement options", "coarsest_level/finest_level",
@@ -243,14 +247,18 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
     if (level == finest_refined) break;
     // Adaptivity: a child face is refined when its parent was and one of the parent's
     // corners moved by more than the threshold at this level (details not small), and,
-    // below the median level, when it still covers min_patch_area (patch_levels.h).
+    // below the median level, when it still covers min_patch_area, or, where a corner moved
+    // by more than detail_threshold, min_detail_patch_area (patch_levels.h).
     const geometry::Faces& F = hierarchy.LevelFaces(level);
     std::vector<char> next(hierarchy.FaceCount(level + 1), 0);
     for (int f = 0; f < hierarchy.FaceCount(level); ++f) {
-      const bool refine = active[f] && (moved[F(f, 0)] || moved[F(f, 1)] || moved[F(f, 2)]);
+      const int corner_moved = std::max({moved[F(f, 0)], moved[F(f, 1)], moved[F(f, 2)]});
+      if (!active[f] || corner_moved == 0) continue;
       for (int k = 0; k < 4; ++k) {
         const int child = LoopHierarchy::ChildFace(f, k);
-        next[child] = refine && (options.finest_level >= 0 || patch_levels.Resolved(level + 1, child)) ? 1 : 0;
+        next[child] = options.finest_level >= 0 || patch_levels.Resolved(level + 1, child) ||
+                              (corner_moved == 2 && patch_levels.ResolvedForDetail(level + 1, child))
+                          ? 1 : 0;
       }
     }
     active = std::move(next);

@@ -97,6 +97,12 @@ struct StereoRefinementOptions {
   // deepest level any patch reaches (solver/stereo/patch_levels.h); false = stop at the
   // median level everywhere.
   bool per_patch_levels = true;
+  // With per_patch_levels: below min_patch_area, a patch is still refined where one of its
+  // parent's corners moved by more than detail_threshold × the parent level's edge length h
+  // (large details: a hollow, a thin part or a crease the coarser level could not follow),
+  // down to patches of min_detail_patch_area pixels² (patch_levels.h). 0 = off.
+  double detail_threshold = 0.1;
+  double min_detail_patch_area = 5.0;
   // Levels ≥ this refine the normal detail only (dof 1). Tangential increments are nearly
   // unconstrained by stereo (the correlation does not change when the surface slides along
   // itself), so by default every level keeps the tangential motion of motion
