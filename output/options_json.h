@@ -124,7 +124,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(NormalFlowSolverOptions, smoothness, rigid_in
                                    collinearity_min_cameras, cg_tolerance, cg_reweighting_tolerance,
                                    cg_max_iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solver, image_sigmas)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations,
+                                   guess_from_targets)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(WindowSolverOptions, linear_solver, max_iterations, threads, function_tolerance)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
                                    per_patch_levels, detail_threshold, min_detail_patch_area,

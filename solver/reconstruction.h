@@ -45,7 +45,8 @@ struct ReconstructionOptions {
   double retrack_weight = 0.25;
 
   void Check() const;  // throws subflow::Error naming the field
-  // The options of the second motion pass: `motion` with hull_weight = retrack_weight.
+  // The options of the second motion pass: `motion` with hull_weight = retrack_weight and
+  // each step started at the refined trajectories' step (guess_from_targets).
   MotionInitOptions RetrackOptions() const;
 };
 

@@ -109,7 +109,11 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   ProgressBegin(progress, "motion initialization", static_cast<std::size_t>(frame_count - 1));
   auto propagate = [&](int from, int to, const std::vector<cv::Mat>& from_images,
                        const std::vector<cv::Mat>& to_images) {
-    const MotionStep step = estimator.Estimate(result.control[from], from_images, to_images);
+    const Positions* target = fitted(to);
+    Positions guess;
+    if (options.guess_from_targets && target) guess = *target - result.control[from];
+    const MotionStep step =
+        estimator.Estimate(result.control[from], from_images, to_images, guess.rows() > 0 ? &guess : nullptr);
     Positions control = result.control[from] + step.displacement;
     MotionFrameReport& report = result.frames[to];
     report.from_frame = from;
@@ -120,7 +124,7 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
                    "software writes for a dropped one?): no image motion between them, so the surface stands "
                    "still there and the motion of the dropped frame lands in the next step",
                    images.first_frame + to, images.first_frame + from);
-    if (const Positions* target = fitted(to); target && options.hull_weight > 0.0) {
+    if (target && options.hull_weight > 0.0) {
       const geometry::ClosestPointTree tree(estimator.visibility().Tessellation(*target),
                                             "fitted surface of frame " + std::to_string(to));
       SurfaceSnapOptions snap;

@@ -35,6 +35,11 @@ struct MotionInitOptions {
   double hull_weight = 0.5;
   double hull_max_distance = 0.0;
   int hull_iterations = 2;
+  // Start each step's first pass at the displacement from the current control points to
+  // the target frame's own surface (when it has one) instead of at zero: for the retrack
+  // pass, whose targets are the refined shapes — one connectivity whose vertices already
+  // follow the material — not for independent per-frame fits (shape initialization's).
+  bool guess_from_targets = false;
 
   void Check() const;  // throws subflow::Error naming the field
 };

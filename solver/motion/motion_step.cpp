@@ -53,7 +53,7 @@ MotionStepEstimator::MotionStepEstimator(const geometry::LoopHierarchy& hierarch
 
 MotionStep MotionStepEstimator::Estimate(const Positions& control,
                                          const std::vector<cv::Mat>& before,
-                                         const std::vector<cv::Mat>& after) const {
+                                         const std::vector<cv::Mat>& after, const Positions* guess) const {
   const auto start = std::chrono::steady_clock::now();
   const int n = hierarchy_->finest_level();
   if (control.rows() != hierarchy_->VertexCount(n))
@@ -80,6 +80,11 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
   step.report.multi_view_samples = visibility.SamplesSeenBy(2);
   step.displacement = Positions::Zero(control.rows(), 3);
   Positions sample_motion;  // empty: zero guess on the first pass
+  if (guess) {
+    if (guess->rows() != control.rows() || guess->cols() != 3 || !guess->allFinite())
+      ThrowError("motion step", "guess", "expected #V(n) = " + std::to_string(control.rows()) + " finite rows");
+    sample_motion = solver_.SampleMotion(*guess);
+  }
   const int passes = static_cast<int>(options_.image_sigmas.size());
   std::vector<SmoothedImage> smoothed_before, smoothed_after;
   for (int pass = 0; pass < passes; ++pass) {

@@ -73,9 +73,11 @@ class MotionStepEstimator {
                       const MotionStepOptions& options = {});
 
   // Displacement of `control` (finest control points at the `before` frame) between the
-  // two sets of images (one per camera).
+  // two sets of images (one per camera). `guess` (optional, #V(n)×3): a displacement the
+  // first pass linearizes at instead of zero (e.g. the step of trajectories known to be
+  // close), so that fewer passes from coarse σ are needed.
   MotionStep Estimate(const geometry::Positions& control, const std::vector<cv::Mat>& before,
-                      const std::vector<cv::Mat>& after) const;
+                      const std::vector<cv::Mat>& after, const geometry::Positions* guess = nullptr) const;
 
   const SurfaceSamples& samples() const { return samples_; }
   const VisibilityTester& visibility() const { return visibility_; }
