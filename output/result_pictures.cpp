@@ -49,7 +49,13 @@ class PictureWriter {
   // Writes `picture` (with the bar of `scale` when given) at <out>/<relative>.
   void Write(const std::string& relative, const cv::Mat& picture, const vision::ZBuffer& zbuffer,
              const std::string& kind, int frame, const std::string& view, const ColourScale* scale) {
-    Picture entry{relative, kind, frame, view, zbuffer.CoveredPixelCount(), zbuffer.width() * zbuffer.height()};
+    Picture entry;
+    entry.path = relative;
+    entry.kind = kind;
+    entry.frame = frame;
+    entry.view = view;
+    entry.surface_pixels = zbuffer.CoveredPixelCount();
+    entry.pixels = zbuffer.width() * zbuffer.height();
     cv::Mat written = picture;
     if (scale) {
       written = WithColourBar(picture, *scale, &entry.bar);

@@ -12,6 +12,16 @@
 #include "vision/rotation.h"
 
 namespace subflow::vision {
+
+int ImageSideFromNumber(double value, const std::string& source, const std::string& field) {
+  if (!(value >= 1 && value <= kMaxImageSide) || value != std::floor(value)) {
+    std::ostringstream got;
+    got << value;
+    ThrowError(source, field,
+               "expected a whole number of pixels in [1, " + std::to_string(kMaxImageSide) + "], got " + got.str());
+  }
+  return static_cast<int>(value);
+}
 namespace {
 
 std::string Describe(const Eigen::MatrixXd& m) {

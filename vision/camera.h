@@ -30,6 +30,11 @@ inline constexpr int kMaxImageSide = 1 << 15;
 // The most pixels an image may have (16384², ~268 Mpx: beyond 8K video by 8×).
 inline constexpr long long kMaxImagePixels = 1LL << 28;
 
+// An image side that a calibration file gives as a number (XML, TOML, YAML, JSON): a whole
+// number of pixels in [1, kMaxImageSide], else a subflow::Error "<source>: <field>: expected
+// …, got <value>" (also for NaN and values beyond int, which are never converted).
+int ImageSideFromNumber(double value, const std::string& source, const std::string& field);
+
 class Camera {
  public:
   Camera() = default;

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/file_status.h"
+#include "vision/camera.h"
 #include "vision/import_toml.h"
 
 namespace subflow::vision {
@@ -90,14 +91,12 @@ std::vector<std::string> Names(const cv::FileStorage& storage, const std::string
   return names;
 }
 
-int OptionalInt(const cv::FileStorage& storage, const std::string& key, const std::string& source) {
+// An image side (H_<name>, W_<name>), 0 when absent.
+int OptionalImageSide(const cv::FileStorage& storage, const std::string& key, const std::string& source) {
   const cv::FileNode node = Node(storage, key, source);
   if (node.empty()) return 0;
   if (!node.isInt() && !node.isReal()) ThrowError(source, key, "expected an integer");
-  const double value = node.real();
-  if (!(value >= 1) || value != std::floor(value) || value > 1e6)
-    ThrowError(source, key, "expected a positive integer, got " + std::to_string(value));
-  return static_cast<int>(value);
+  return ImageSideFromNumber(node.real(), source, key);
 }
 
 }  // namespace
@@ -124,8 +123,8 @@ Calibration ParseEasyMocapCalibration(const std::string& intri_yml, const std::s
       for (int i = 0; i < static_cast<int>(mat.total()); ++i) d(0, i) = mat.at<double>(i);
     }
     camera.distortion = Eigen::Map<const Eigen::VectorXd>(d.data(), d.size());
-    camera.height = OptionalInt(intri, "H_" + name, intri_source);
-    camera.width = OptionalInt(intri, "W_" + name, intri_source);
+    camera.height = OptionalImageSide(intri, "H_" + name, intri_source);
+    camera.width = OptionalImageSide(intri, "W_" + name, intri_source);
     const Eigen::MatrixXd rvec = Matrix(extri, "R_" + name, 3, 1, extri_source, false);
     if (rvec.size() == 3) camera.R = RodriguesToRotation(Eigen::Vector3d(rvec(0), rvec(1), rvec(2)));
     else camera.R = Matrix(extri, "Rot_" + name, 3, 3, extri_source);

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "vision/camera.h"
 
 namespace subflow::vision {
 namespace {
@@ -54,11 +55,8 @@ Calibration ParsePanopticCalibration(const std::string& text, const std::string&
     camera.name = entry["name"].get<std::string>();
     camera.source = source + ": " + where;
     const Eigen::MatrixXd size = Numbers(entry["resolution"], 1, 2, source, where + ".resolution");
-    for (int k = 0; k < 2; ++k)
-      if (!(size(0, k) >= 1) || size(0, k) != std::floor(size(0, k)) || size(0, k) > 1e6)
-        ThrowError(source, where + ".resolution", "expected two positive integers");
-    camera.width = static_cast<int>(size(0, 0));
-    camera.height = static_cast<int>(size(0, 1));
+    camera.width = ImageSideFromNumber(size(0, 0), source, where + ".resolution[0] (width)");
+    camera.height = ImageSideFromNumber(size(0, 1), source, where + ".resolution[1] (height)");
     camera.K = Numbers(entry["K"], 3, 3, source, where + ".K");
     const json& d = entry["distCoef"];
     const int n = d.is_array() ? static_cast<int>(d.size()) : 0;

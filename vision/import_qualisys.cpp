@@ -7,6 +7,7 @@
 #include <pugixml.hpp>
 
 #include "core/error.h"
+#include "vision/camera.h"
 #include "vision/natural_order.h"
 
 namespace subflow::vision {
@@ -54,15 +55,11 @@ CalibratedCamera ReadCamera(const QcaCamera& qca, const std::string& name, const
   camera.source = source;
   const pugi::xml_node fov = qca.Child("fov_video");
   const double left = qca.Number(fov, "left"), top = qca.Number(fov, "top");
-  const double width = (qca.Number(fov, "right") - left + 1) / b;
-  const double height = (qca.Number(fov, "bottom") - top + 1) / b;
-  if (!(width >= 1) || !(height >= 1) || width != std::floor(width) || height != std::floor(height))
-    ThrowError(source, qca.Field("fov_video"),
-               "expected right ≥ left and bottom ≥ top giving a whole image size at binning factor " +
-                   std::to_string(options.binning_factor) + ", got " + std::to_string(width) + "×" +
-                   std::to_string(height));
-  camera.width = static_cast<int>(width);
-  camera.height = static_cast<int>(height);
+  const std::string binned = " (right − left + 1 at binning factor " + std::to_string(options.binning_factor) + ")";
+  camera.width = ImageSideFromNumber((qca.Number(fov, "right") - left + 1) / b, source,
+                                     qca.Field("fov_video: image width" + binned));
+  camera.height = ImageSideFromNumber((qca.Number(fov, "bottom") - top + 1) / b, source,
+                                      qca.Field("fov_video: image height" + binned));
 
   const pugi::xml_node intrinsic = qca.Child("intrinsic");
   const double unit = 64.0 * b;  // QTM's sub-pixel units per (binned) pixel

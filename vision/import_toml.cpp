@@ -7,6 +7,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.h"
+#include "vision/camera.h"
 
 namespace subflow::vision {
 namespace {
@@ -58,11 +59,7 @@ class TomlCamera {
     return out;
   }
 
-  int Whole(double value, const std::string& field) const {
-    if (!(value >= 1) || value != std::floor(value) || value > 1e6)
-      ThrowError(source_, Field(field), "expected a positive whole number of pixels, got " + std::to_string(value));
-    return static_cast<int>(value);
-  }
+  int Whole(double value, const std::string& field) const { return ImageSideFromNumber(value, source_, Field(field)); }
 
  private:
   const toml::table& table_;

@@ -57,7 +57,7 @@ void AddDampingResidual(RefinementWindow& window, int frame, int vertex, ceres::
   const double weight = window.options->damping;
   if (weight <= 0) return;
   std::vector<Eigen::MatrixXd> A{Eigen::MatrixXd::Identity(window.dof, window.dof) * (weight * (1.0 / window.h))};
-  problem->AddResidualBlock(new LinearResidualCost(std::move(A)), nullptr, {window.Increment(frame, vertex)});
+  problem->AddResidualBlock(new LinearResidualCost(std::move(A)), nullptr, window.Increment(frame, vertex));
 }
 
 std::pair<double, double> SlabRange(const Eigen::Vector3d& p, const Eigen::Vector3d& n,

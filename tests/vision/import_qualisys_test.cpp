@@ -187,6 +187,12 @@ TEST(QualisysImport, MalformedFilesNameTheCameraAndAttribute) {
   EXPECT_NE(e.find("XML"), std::string::npos) << e;
   e = with("serial=\"cam02\"", "serial=\"cam01\"");
   EXPECT_NE(e.find("unique"), std::string::npos) << e;
+  // An image size beyond any sensor is refused before it becomes an int (clang's UBSan found
+  // the conversion of 1e11 overflowing in BrokenInputs).
+  e = with("<fov_video bottom=\"", "<fov_video bottom=\"1e11\" was=\"");
+  EXPECT_NE(e.find("bad.qca.txt"), std::string::npos) << e;
+  EXPECT_NE(e.find("fov_video: image height"), std::string::npos) << e;
+  EXPECT_NE(e.find("whole number of pixels in [1, 32768], got 1e+11"), std::string::npos) << e;
   e = with("model=\"none\"", "model=\"Miqus M3\"");  // a marker camera is left out, not an error
   EXPECT_EQ(e, "no error");
   // A transform that is no rotation (one entry of M negated) is refused.
