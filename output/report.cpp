@@ -188,7 +188,7 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
                       {"cg_iterations", f.step.cg_iterations},
                       {"corrected", f.corrected},
                       {"correction_rms_before", f.correction_rms_before},
-                      {"correction_rms_after", f.correction_rms_after},
+                      {"correction_rms_applied", f.correction_rms_applied},
                       {"seconds", f.step.seconds}});
   }
   return {{"options", o},

@@ -131,11 +131,12 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
       snap.weight = options.hull_weight;
       snap.max_distance = max_correction;
       snap.iterations = options.hull_iterations;
+      snap.measure_after = false;
       SurfaceSnapReport snap_report;
       control = SnapToSurface(hierarchy, n, control, tree, snap, &snap_report);
       report.corrected = true;
       report.correction_rms_before = snap_report.rms_distance_before;
-      report.correction_rms_after = snap_report.rms_distance_after;
+      report.correction_rms_applied = snap_report.rms_correction;
     }
     result.control[to] = std::move(control);
     spdlog::debug("motion init: frame {} -> {}: {} constraints, {} pruned, photometric rms {:.4f} "

@@ -50,8 +50,8 @@ struct MotionFrameReport {
   bool identical_images = false;  // every camera's image equals from_frame's (a duplicated frame)
   MotionStepReport step;
   bool corrected = false;           // normal correction applied
-  double correction_rms_before = 0.0;  // RMS normal distance to the frame's fitted surface
-  double correction_rms_after = 0.0;
+  double correction_rms_before = 0.0;   // RMS normal distance to the frame's fitted surface
+  double correction_rms_applied = 0.0;  // RMS length of the correction applied to the control points
 };
 
 struct MotionInitResult {

@@ -70,7 +70,8 @@ Positions SnapToSurface(const geometry::LoopHierarchy& hierarchy, int level,
     snapped += (normals.array().colwise() * distance.array()).matrix();
   }
   Positions result = control + options.weight * (snapped - control);
-  if (report) {
+  if (report) report->rms_correction = Rms((result - control).rowwise().norm());
+  if (report && options.measure_after) {
     int unused = 0;
     report->rms_distance_after =
         Rms(NormalDistances(hierarchy, level, result, target, options.max_distance, &normals, &unused));

@@ -28,13 +28,18 @@ struct SurfaceSnapOptions {
   // Largest |t| accepted (world units); farther hits are ignored.
   double max_distance = std::numeric_limits<double>::infinity();
   int iterations = 3;
+  // Cast once more after the last pass to measure rms_distance_after (a third more ray
+  // casts at the default iterations). Motion initialization, which snaps every frame
+  // step, reports the applied correction instead (rms_correction, free).
+  bool measure_after = true;
 
   void Check() const;  // throws subflow::Error naming the field
 };
 
 struct SurfaceSnapReport {
   double rms_distance_before = 0.0;  // of the limit points to the target along n, first pass
-  double rms_distance_after = 0.0;   // measured once more after the last pass
+  double rms_distance_after = 0.0;   // measured once more after the last pass (measure_after; else 0)
+  double rms_correction = 0.0;       // RMS of |result − control| over the control points
   int vertices_without_hit = 0;      // in the first pass
 };
 

@@ -1,11 +1,14 @@
 #include "solver/shape/hierarchy_fit.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "geometry/closest_point.h"
 #include "core/error.h"
 #include "geometry/icosphere.h"
 #include "geometry/loop_hierarchy.h"
+#include "solver/shape/surface_snapping.h"
 
 namespace subflow::solver {
 namespace {
@@ -51,6 +54,35 @@ TEST(HierarchyFit, RejectsBaseControlPointsOfTheWrongSize) {
   Positions with_nan = base.V;
   with_nan(0, 0) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(FitHierarchyToSurface(hierarchy, with_nan, target, HierarchyFitOptions()), Error);
+}
+
+// Motion initialization snaps every frame step without the extra cast that only measures
+// the distance left (measure_after = false): the snapped points must be the same, and the
+// applied correction must be reported exactly (and scale with the blend weight).
+TEST(SurfaceSnapping, SkippingTheMeasurementAfterwardsChangesNothingButTheReport) {
+  const geometry::TriangleMesh base = geometry::MakeIcosphere(1, 1.0);
+  const geometry::ClosestPointTree target(geometry::MakeIcosphere(4, 1.2), "sphere");
+  const geometry::LoopHierarchy hierarchy(base.F, base.vertex_count(), 1);
+  const Positions control = hierarchy.Refine(base.V, 0, 1);
+  SurfaceSnapOptions snap;
+  snap.weight = 0.5;
+  snap.iterations = 2;
+  snap.max_distance = 1.0;
+  SurfaceSnapReport measured, unmeasured;
+  const Positions with = SnapToSurface(hierarchy, 1, control, target, snap, &measured);
+  snap.measure_after = false;
+  const Positions without = SnapToSurface(hierarchy, 1, control, target, snap, &unmeasured);
+  EXPECT_EQ((with - without).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(measured.rms_distance_before, 0.15);  // the limit surface is inside the unit sphere
+  EXPECT_LT(measured.rms_distance_after, 0.6 * measured.rms_distance_before);
+  EXPECT_EQ(unmeasured.rms_distance_after, 0.0);
+  EXPECT_EQ(unmeasured.rms_distance_before, measured.rms_distance_before);
+  const double rms = std::sqrt((without - control).rowwise().squaredNorm().mean());
+  EXPECT_NEAR(unmeasured.rms_correction, rms, 1e-12);
+  snap.weight = 1.0;
+  SurfaceSnapReport full;
+  SnapToSurface(hierarchy, 1, control, target, snap, &full);
+  EXPECT_NEAR(unmeasured.rms_correction, 0.5 * full.rms_correction, 1e-12);
 }
 
 }  // namespace
