@@ -51,9 +51,6 @@ ColmapIntrinsics Intrinsics(const ModelInfo& model, const std::vector<double>& p
                             const std::string& source, const std::string& field) {
   for (double value : p)
     if (!std::isfinite(value)) ThrowError(source, field, "expected finite parameters");
-  if (width <= 0 || height <= 0)
-    ThrowError(source, field, "expected a positive width and height, got " + std::to_string(width) + " " +
-                                  std::to_string(height));
   const std::string name = model.name;
   const bool single_focal = p.size() == 3 || name == "SIMPLE_RADIAL" || name == "RADIAL" ||
                             name == "SIMPLE_RADIAL_FISHEYE" || name == "RADIAL_FISHEYE";
@@ -193,9 +190,9 @@ Calibration ParseColmapTextModel(const std::string& cameras_txt, const std::stri
     if (in >> extra)
       ThrowError(cameras_source, field + ": PARAMS",
                  "expected exactly " + std::to_string(info->parameters) + " numbers for model " + model + ", got more");
-    if (width > 1000000 || height > 1000000) width = height = -1;
-    if (!intrinsics.emplace(id, Intrinsics(*info, p, static_cast<int>(width), static_cast<int>(height),
-                                           cameras_source, field + ": WIDTH HEIGHT PARAMS")).second)
+    const int w = ImageSideFromNumber(static_cast<double>(width), cameras_source, field + ": WIDTH");
+    const int h = ImageSideFromNumber(static_cast<double>(height), cameras_source, field + ": HEIGHT");
+    if (!intrinsics.emplace(id, Intrinsics(*info, p, w, h, cameras_source, field + ": PARAMS")).second)
       ThrowError(cameras_source, field + ": CAMERA_ID", "duplicate camera id " + std::to_string(id));
   }
   Calibration calibration;
@@ -245,7 +242,8 @@ Calibration ParseColmapBinaryModel(const std::string& cameras_bin, const std::st
     }
     std::vector<double> p(info->parameters);
     for (double& value : p) value = cameras.Read<double>(field + ": params");
-    const int w = width > 1000000 ? -1 : static_cast<int>(width), h = height > 1000000 ? -1 : static_cast<int>(height);
+    const int w = ImageSideFromNumber(static_cast<double>(width), cameras_source, field + ": width");
+    const int h = ImageSideFromNumber(static_cast<double>(height), cameras_source, field + ": height");
     if (!intrinsics.emplace(id, Intrinsics(*info, p, w, h, cameras_source, field)).second)
       ThrowError(cameras_source, field + ": id", "duplicate camera id " + std::to_string(id));
   }

@@ -55,11 +55,11 @@ CalibratedCamera ReadCamera(const QcaCamera& qca, const std::string& name, const
   camera.source = source;
   const pugi::xml_node fov = qca.Child("fov_video");
   const double left = qca.Number(fov, "left"), top = qca.Number(fov, "top");
-  const std::string binned = " (right − left + 1 at binning factor " + std::to_string(options.binning_factor) + ")";
+  const std::string binning = " at binning factor " + std::to_string(options.binning_factor) + ")";
   camera.width = ImageSideFromNumber((qca.Number(fov, "right") - left + 1) / b, source,
-                                     qca.Field("fov_video: image width" + binned));
+                                     qca.Field("fov_video: image width (right − left + 1" + binning));
   camera.height = ImageSideFromNumber((qca.Number(fov, "bottom") - top + 1) / b, source,
-                                      qca.Field("fov_video: image height" + binned));
+                                      qca.Field("fov_video: image height (bottom − top + 1" + binning));
 
   const pugi::xml_node intrinsic = qca.Child("intrinsic");
   const double unit = 64.0 * b;  // QTM's sub-pixel units per (binned) pixel

@@ -130,6 +130,14 @@ TEST(ColmapImport, MalformedFilesNameFileAndLine) {
   EXPECT_CONTAINS(message, "cameras.txt: line 1: PARAMS");
   EXPECT_CONTAINS(message, "expected 4 numbers");
 
+  std::ofstream(dir / "cameras.txt") << "1 PINHOLE 40000 480 500 500 320 240\n";
+  message = ErrorOf([&] { ReadColmapTextModel(dir.string()); });
+  EXPECT_CONTAINS(message, "cameras.txt: line 1: WIDTH");
+  EXPECT_CONTAINS(message, "expected a whole number of pixels in [1, 32768], got 40000");
+  std::ofstream(dir / "cameras.txt") << "1 PINHOLE 640 0 500 500 320 240\n";
+  message = ErrorOf([&] { ReadColmapTextModel(dir.string()); });
+  EXPECT_CONTAINS(message, "cameras.txt: line 1: HEIGHT");
+
   std::ofstream(dir / "cameras.txt") << "1 PINHOLE 640 480 500 500 320 240\n";
   std::ofstream(dir / "images.txt") << "1 1 0 0 0 0 0 1 9 a.png\n\n";
   message = ErrorOf([&] { ReadColmapTextModel(dir.string()); });
