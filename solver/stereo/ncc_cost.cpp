@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include <Eigen/Cholesky>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -199,14 +200,20 @@ void PatchCorrelationCost::Setup(int views, int samples, int block_count) {
   for (std::size_t v = 0; v < sampled_.size(); ++v)
     if (!view_rows_[v].empty() && view_rows_[v].back() >= sampled_[v]->intensities.size())
       ThrowError("PatchCorrelationCost", "sampled views", "a pair compares a row the view does not have");
-  int residuals = 0;
-  for (const CorrelationPair& pair : pairs_) residuals += static_cast<int>(pair.rows.size());
-  set_num_residuals(residuals);
+  pair_residuals_ = 0;
+  for (const CorrelationPair& pair : pairs_) pair_residuals_ += static_cast<int>(pair.rows.size());
+  set_num_residuals(pair_residuals_);
   for (int i = 0; i < block_count; ++i) mutable_parameter_block_sizes()->push_back(dof_);
 }
 
-bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* residuals,
-                                    double** jacobians) const {
+void PatchCorrelationCost::UseReducedForm() {
+  const int unknowns = static_cast<int>(parameter_block_sizes().size()) * dof_;
+  reduced_ = unknowns + 1 < pair_residuals_;
+  set_num_residuals(reduced_ ? unknowns + 1 : pair_residuals_);
+}
+
+void PatchCorrelationCost::Correlate(double const* const* parameters, double* residuals,
+                                     RowJacobian* jacobian) const {
   const int columns = support_ * dof_;
   // Per-thread scratch: Ceres evaluates blocks concurrently, and this is the hot path.
   thread_local std::vector<SampledView> own;
@@ -218,18 +225,13 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
     views.resize(views_.size());
     for (std::size_t v = 0; v < views_.size(); ++v) {
       SampleView(views_[v], stencil_, dof_, parameters, &own[v].intensities,
-                 jacobians ? &own[v].jacobian : nullptr, &view_rows_[v]);
+                 jacobian ? &own[v].jacobian : nullptr, &view_rows_[v]);
       views[v] = &own[v];
     }
   } else {
     views.assign(sampled_.begin(), sampled_.end());
   }
-
-  const int blocks = static_cast<int>(parameter_block_sizes().size());
-  if (jacobians)
-    for (int block = 0; block < blocks; ++block)
-      if (jacobians[block])
-        std::fill(jacobians[block], jacobians[block] + num_residuals() * dof_, 0.0);
+  if (jacobian) jacobian->setZero(pair_residuals_, static_cast<Eigen::Index>(parameter_block_sizes().size()) * dof_);
 
   int offset = 0;
   for (const CorrelationPair& pair : pairs_) {
@@ -239,7 +241,7 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
     const SampledView& b = *views[pair.b];
     xa.resize(n);
     xb.resize(n);
-    if (jacobians) {
+    if (jacobian) {
       ja.resize(n, columns);
       jb.resize(n, columns);
     }
@@ -247,26 +249,77 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
       const int k = pair.rows[i];
       xa(i) = a.intensities(k);
       xb(i) = b.intensities(k);
-      if (jacobians) {
+      if (jacobian) {
         ja.row(i) = a.jacobian.row(k);
         jb.row(i) = b.jacobian.row(k);
       }
     }
-    NormalizeInPlace(xa, epsilon_, jacobians ? &ja : nullptr);
-    NormalizeInPlace(xb, epsilon_, jacobians ? &jb : nullptr);
+    NormalizeInPlace(xa, epsilon_, jacobian ? &ja : nullptr);
+    NormalizeInPlace(xb, epsilon_, jacobian ? &jb : nullptr);
     Eigen::Map<Eigen::VectorXd>(residuals + offset, n) = sqrt_weight * (xa - xb);
-    if (jacobians) {
-      const int first_a = first_blocks_[pair.a], first_b = first_blocks_[pair.b];
-      for (int block = 0; block < blocks; ++block) {
-        if (!jacobians[block]) continue;
-        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
-            jacobians[block] + static_cast<std::ptrdiff_t>(offset) * dof_, n, dof_);
-        const int in_a = block - first_a, in_b = block - first_b;
-        if (in_a >= 0 && in_a * dof_ < columns) J += sqrt_weight * ja.middleCols(in_a * dof_, dof_);
-        if (in_b >= 0 && in_b * dof_ < columns) J -= sqrt_weight * jb.middleCols(in_b * dof_, dof_);
-      }
+    if (jacobian) {
+      jacobian->block(offset, first_blocks_[pair.a] * dof_, n, columns) += sqrt_weight * ja;
+      jacobian->block(offset, first_blocks_[pair.b] * dof_, n, columns) -= sqrt_weight * jb;
     }
     offset += n;
+  }
+}
+
+void PatchCorrelationCost::PairResiduals(double const* const* parameters, double* residuals) const {
+  Correlate(parameters, residuals, nullptr);
+}
+
+bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* residuals,
+                                    double** jacobians) const {
+  const int blocks = static_cast<int>(parameter_block_sizes().size());
+  const int unknowns = blocks * dof_;
+  thread_local Eigen::VectorXd r;
+  thread_local RowJacobian J;
+  if (!reduced_) {
+    Correlate(parameters, residuals, jacobians ? &J : nullptr);
+    if (jacobians)
+      for (int block = 0; block < blocks; ++block)
+        if (jacobians[block])
+          Eigen::Map<RowJacobian>(jacobians[block], pair_residuals_, dof_) = J.middleCols(block * dof_, dof_);
+    return true;
+  }
+  r.resize(pair_residuals_);
+  Correlate(parameters, r.data(), jacobians ? &J : nullptr);
+  const double squared_norm = r.squaredNorm();
+  Eigen::Map<Eigen::VectorXd> reduced(residuals, unknowns + 1);
+  if (!jacobians) {
+    reduced.setZero();
+    reduced(0) = std::sqrt(squared_norm);
+    return true;
+  }
+  // L Lᵀ = JᵀJ + δI, r̃ = [L⁻¹ Jᵀr ; rest], J̃ = [Lᵀ ; 0] (UseReducedForm in the header).
+  thread_local Eigen::MatrixXd normal;
+  thread_local Eigen::VectorXd gradient;
+  normal.setZero(unknowns, unknowns);
+  normal.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+  gradient.noalias() = J.transpose() * r;
+  const double largest = normal.diagonal().maxCoeff();
+  thread_local Eigen::MatrixXd shifted, factor;  // JᵀJ + δI; Lᵀ (upper triangular)
+  factor.setZero(unknowns, unknowns);
+  reduced.setZero();
+  if (largest > 0.0) {
+    // JᵀJ is positive semi-definite; rounding can leave it a few ulps short, which δ covers.
+    for (double jitter = 1e-12 * largest; jitter <= 1e-6 * largest; jitter *= 1e3) {
+      shifted = normal;
+      shifted.diagonal().array() += jitter;
+      Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> cholesky(shifted);
+      if (cholesky.info() != Eigen::Success) continue;
+      reduced.head(unknowns) = cholesky.matrixL().solve(gradient);
+      factor = cholesky.matrixU();
+      break;
+    }
+  }
+  reduced(unknowns) = std::sqrt(std::max(0.0, squared_norm - reduced.head(unknowns).squaredNorm()));
+  for (int block = 0; block < blocks; ++block) {
+    if (!jacobians[block]) continue;
+    Eigen::Map<RowJacobian> Jb(jacobians[block], unknowns + 1, dof_);
+    Jb.topRows(unknowns) = factor.middleCols(block * dof_, dof_);
+    Jb.row(unknowns).setZero();
   }
   return true;
 }

@@ -115,11 +115,32 @@ class PatchCorrelationCost final : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // The reduced form (call before the block is added to a problem; it changes
+  // num_residuals). The m pair residuals r, with Jacobian J (m × n, n = blocks · dof), are
+  // replaced by n + 1 entries with the same squared norm, normal matrix and gradient:
+  //     r̃ = [L⁻¹ Jᵀr ; √(‖r‖² − ‖L⁻¹ Jᵀr‖²)],   J̃ = [Lᵀ ; 0],   L Lᵀ = JᵀJ + δI
+  // (δ = 1e-12 of the largest diagonal entry, so that L exists where J is rank-deficient).
+  // Then ‖r̃‖² = ‖r‖², J̃ᵀJ̃ = JᵀJ + δI and J̃ᵀr̃ = Jᵀr, so a Gauss-Newton or
+  // Levenberg-Marquardt step, a robust loss's correction (which only needs ‖r‖², Jᵀr and
+  // JᵀJ) and the cost Ceres compares are those of the full block, while Ceres stores,
+  // scales and multiplies an (n + 1) × n Jacobian instead of m × n (the patches' blocks
+  // have m ≈ 10–20 n). When only the residuals are asked for, r̃ = [‖r‖, 0, …, 0].
+  // No effect when m ≤ n + 1.
+  void UseReducedForm();
+  bool reduced() const { return reduced_; }
+
   const std::vector<CorrelationPair>& pairs() const { return pairs_; }
+  // The pairs' residuals √W (x̂_a − x̂_b), concatenated in pair order (pair_residual_count()
+  // entries), whatever the form: per pair NCC = 1 − ‖r_pair‖² / (2 W) when ε = 0.
+  int pair_residual_count() const { return pair_residuals_; }
+  void PairResiduals(double const* const* parameters, double* residuals) const;
 
  private:
   // Checks the pairs and the block count; sets the residual and parameter block sizes.
   void Setup(int views, int samples, int block_count);
+  // The pair residuals (pair_residual_count()) and, when `jacobian` is given, their
+  // Jacobian with respect to all blocks (pair_residual_count() × blocks · dof).
+  void Correlate(double const* const* parameters, double* residuals, RowJacobian* jacobian) const;
 
   PatchStencil stencil_;
   std::vector<PatchView> views_;              // sampled by Evaluate (first two constructors)
@@ -130,6 +151,8 @@ class PatchCorrelationCost final : public ceres::CostFunction {
   int support_;
   int dof_;
   double epsilon_;
+  int pair_residuals_ = 0;
+  bool reduced_ = false;
 };
 
 // Signed distance to a silhouette's outline, and its gradient, for SilhouetteCost.

@@ -65,7 +65,9 @@ PatchCorrelationCost* CorrelationCost(RefinementWindow& window, int face, const 
   if (!window.views) {
     std::vector<PatchView> own;
     for (const ViewKey& key : views) own.push_back(MakeView(window, key.frame, key.camera, face, key.first_block));
-    return new PatchCorrelationCost(stencil, std::move(own), std::move(pairs), block_count, window.dof, epsilon);
+    auto* cost = new PatchCorrelationCost(stencil, std::move(own), std::move(pairs), block_count, window.dof, epsilon);
+    if (window.options->solver.reduced_correlation_blocks) cost->UseReducedForm();
+    return cost;
   }
   const std::vector<std::vector<int>> rows =
       RowsOfViews(pairs, static_cast<int>(views.size()), static_cast<int>(stencil.rows()));
@@ -80,8 +82,10 @@ PatchCorrelationCost* CorrelationCost(RefinementWindow& window, int face, const 
         std::move(increments), rows[v]));
     first_blocks.push_back(key.first_block);
   }
-  return new PatchCorrelationCost(std::move(sampled), std::move(first_blocks), std::move(pairs),
-                                  static_cast<int>(support.size()), block_count, window.dof, epsilon);
+  auto* cost = new PatchCorrelationCost(std::move(sampled), std::move(first_blocks), std::move(pairs),
+                                        static_cast<int>(support.size()), block_count, window.dof, epsilon);
+  if (window.options->solver.reduced_correlation_blocks) cost->UseReducedForm();
+  return cost;
 }
 
 }  // namespace

@@ -76,6 +76,10 @@ struct WindowSolverOptions {
   // 0.0425 / 89 s, 1e-2 → 0.428 mm / 0.0430 / 74 s; bust_front 8 frames, 1e-4 → 1.109 mm
   // / 0.0568 / 39 s, 3e-3 → 1.095 mm / 0.0556 / 29 s.
   double function_tolerance = 3e-3;
+  // Correlation blocks in their reduced form (PatchCorrelationCost::UseReducedForm): the
+  // same steps up to rounding, with an (n + 1) × n Jacobian per block instead of m × n.
+  // An implementation choice, not a setting of the method: not in options files.
+  bool reduced_correlation_blocks = true;
 
   void Check() const;  // throws subflow::Error naming the field (and what Ceres objects to)
   // ceres::Solver::Options with these settings, silent.

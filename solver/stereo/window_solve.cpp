@@ -26,11 +26,12 @@ void Evaluate(ceres::Problem& problem, const std::vector<ResidualRecord>& record
   sum->assign(frames, 0.0);
   count->assign(frames, 0);
   Eigen::VectorXd r;
+  std::vector<double*> blocks;
   for (const ResidualRecord& record : records) {
-    double cost = 0.0;
-    r.resize(problem.GetCostFunctionForResidualBlock(record.id)->num_residuals());
-    problem.EvaluateResidualBlockAssumingParametersUnchanged(record.id, false, &cost, r.data(), nullptr);
     if (ncc) {
+      problem.GetParameterBlocksForResidualBlock(record.id, &blocks);
+      r.resize(record.correlation->pair_residual_count());
+      record.correlation->PairResiduals(blocks.data(), r.data());
       int offset = 0;
       for (const CorrelationPair& pair : record.correlation->pairs()) {
         const int n = static_cast<int>(pair.rows.size());
@@ -42,6 +43,9 @@ void Evaluate(ceres::Problem& problem, const std::vector<ResidualRecord>& record
       }
       continue;
     }
+    double cost = 0.0;
+    r.resize(problem.GetCostFunctionForResidualBlock(record.id)->num_residuals());
+    problem.EvaluateResidualBlockAssumingParametersUnchanged(record.id, false, &cost, r.data(), nullptr);
     (*sum)[record.frame] += std::pow(std::max(0.0, r(0)) / silhouette_weight, 2);
     ++(*count)[record.frame];
   }

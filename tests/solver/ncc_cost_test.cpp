@@ -214,6 +214,66 @@ TEST(PatchCorrelationCost, MultiplePairsAddUpAndDifferentiate) {
   EXPECT_THROW(PatchCorrelationCost(fixture.stencil, views, {}, 3, 1, 0.0), Error);
 }
 
+// The reduced form (UseReducedForm): n + 1 residuals instead of m with the same squared
+// norm, normal matrix JᵀJ and gradient Jᵀr as the full block, so Ceres takes the same
+// steps; the pairs' own residuals stay readable; blocks with m ≤ n + 1 are left as they are.
+TEST(PatchCorrelationCost, ReducedFormKeepsTheNormalEquationsAndTheCost) {
+  Fixture fixture(1, true);
+  const vision::Camera camera_c = vision::LookAtCamera("c", 200, 160, 300.0, {0.0, -0.1, 1.0}, {0, 0, 0});
+  const std::vector<PatchView> views = {fixture.View(fixture.camera_a, fixture.image_a, 0),
+                                        fixture.View(fixture.camera_b, fixture.image_b, 0),
+                                        fixture.View(camera_c, fixture.image_a, 0)};
+  const std::vector<CorrelationPair> pairs = {{0, 1, {0, 1, 2, 3, 4, 5, 6, 7, 8}, 0.9},
+                                              {0, 2, {1, 2, 4, 5, 7}, 0.5},
+                                              {1, 2, {0, 3, 6, 7, 8}, 0.25}};
+  const PatchCorrelationCost full(fixture.stencil, views, pairs, 3, 1, 0.01);
+  PatchCorrelationCost reduced(fixture.stencil, views, pairs, 3, 1, 0.01);
+  reduced.UseReducedForm();
+  ASSERT_TRUE(reduced.reduced());
+  ASSERT_EQ(full.num_residuals(), 19);
+  ASSERT_EQ(reduced.num_residuals(), 4);
+  ASSERT_EQ(reduced.pair_residual_count(), 19);
+
+  std::vector<double> params = fixture.parameters;
+  const double* blocks[3] = {params.data(), params.data() + 1, params.data() + 2};
+  // Full: r (19) and J (19 × 3); reduced: r̃ (4) and J̃ (4 × 3), one column per block (dof 1).
+  Eigen::VectorXd r(19), rr(4);
+  Eigen::Matrix<double, 19, 3> J;
+  Eigen::Matrix<double, 4, 3> JJ;
+  std::vector<double> columns(19 * 3), reduced_columns(4 * 3);
+  double* jacobians[3] = {columns.data(), columns.data() + 19, columns.data() + 38};
+  double* reduced_jacobians[3] = {reduced_columns.data(), reduced_columns.data() + 4, reduced_columns.data() + 8};
+  ASSERT_TRUE(full.Evaluate(blocks, r.data(), jacobians));
+  ASSERT_TRUE(reduced.Evaluate(blocks, rr.data(), reduced_jacobians));
+  for (int b = 0; b < 3; ++b) {
+    J.col(b) = Eigen::Map<Eigen::VectorXd>(jacobians[b], 19);
+    JJ.col(b) = Eigen::Map<Eigen::VectorXd>(reduced_jacobians[b], 4);
+  }
+  ASSERT_GT(J.norm(), 0.0);
+  EXPECT_NEAR(rr.squaredNorm(), r.squaredNorm(), 1e-12 * r.squaredNorm());
+  const Eigen::Matrix3d normal = J.transpose() * J;
+  EXPECT_LT((JJ.transpose() * JJ - normal).norm(), 1e-10 * normal.norm());
+  EXPECT_LT((JJ.transpose() * rr - J.transpose() * r).norm(), 1e-10 * (J.transpose() * r).norm());
+  EXPECT_EQ(JJ.row(3).norm(), 0.0);
+  // The full model cost ½‖Jδ + r‖² equals the reduced one for any step δ.
+  const Eigen::Vector3d step(0.3, -0.2, 0.5);
+  EXPECT_NEAR((JJ * step + rr).squaredNorm(), (J * step + r).squaredNorm(), 1e-10 * r.squaredNorm());
+
+  // Residuals only: the same norm; the pairs' residuals are those of the full block.
+  Eigen::VectorXd cost_only(4), pair_residuals(19);
+  ASSERT_TRUE(reduced.Evaluate(blocks, cost_only.data(), nullptr));
+  EXPECT_NEAR(cost_only.squaredNorm(), r.squaredNorm(), 1e-12 * r.squaredNorm());
+  reduced.PairResiduals(blocks, pair_residuals.data());
+  EXPECT_EQ((pair_residuals - r).norm(), 0.0);
+
+  // One pair of 9 samples on 3 blocks of 3: 9 residuals ≤ 9 + 1, nothing to reduce.
+  PatchCorrelationCost small(fixture.stencil, fixture.View(fixture.camera_a, fixture.image_a, 0),
+                             fixture.View(fixture.camera_b, fixture.image_b, 0), 3, 3, 1.0, 0.0);
+  small.UseReducedForm();
+  EXPECT_FALSE(small.reduced());
+  EXPECT_EQ(small.num_residuals(), 9);
+}
+
 TEST(PatchCorrelationCost, RejectsInconsistentViews) {
   const Fixture fixture(3);
   PatchView short_view = fixture.View(fixture.camera_a, fixture.image_a, 0);

@@ -30,9 +30,10 @@ double MeanStereoNcc(ceres::Problem& problem, const std::vector<ResidualRecord>&
   double sum = 0.0;
   int count = 0;
   for (const ResidualRecord& record : records) {
-    Eigen::VectorXd r(problem.GetCostFunctionForResidualBlock(record.id)->num_residuals());
-    double cost = 0.0;
-    problem.EvaluateResidualBlock(record.id, false, &cost, r.data(), nullptr);
+    std::vector<double*> blocks;
+    problem.GetParameterBlocksForResidualBlock(record.id, &blocks);
+    Eigen::VectorXd r(record.correlation->pair_residual_count());
+    record.correlation->PairResiduals(blocks.data(), r.data());
     int offset = 0;
     for (const CorrelationPair& pair : record.correlation->pairs()) {
       const int n = static_cast<int>(pair.rows.size());

@@ -63,6 +63,30 @@ TEST(StereoRefinement, PerturbedShapeMovesBackTowardsTheTruth) {
   }
 }
 
+// The correlation blocks' reduced form (PatchCorrelationCost::UseReducedForm) gives Ceres
+// the same normal equations, gradient and cost, so the solve takes the same steps: the
+// refined surface agrees with the full blocks' to rounding, not merely to the tolerance
+// of the refinement.
+TEST(StereoRefinement, ReducedCorrelationBlocksTakeTheSameSteps) {
+  const testing::RefinementScene& scene = Scene();
+  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  StereoRefinementOptions options = TestOptions();
+  options.solver.reduced_correlation_blocks = false;
+  const RefinementResult full = scene.Refine(perturbed, 2, options);
+  options.solver.reduced_correlation_blocks = true;
+  const RefinementResult reduced = scene.Refine(perturbed, 2, options);
+  ASSERT_EQ(full.control.size(), reduced.control.size());
+  ASSERT_EQ(full.levels.size(), reduced.levels.size());
+  for (std::size_t l = 0; l < full.levels.size(); ++l)
+    EXPECT_EQ(full.levels[l].iterations, reduced.levels[l].iterations) << "level " << l;
+  for (std::size_t f = 0; f < full.control.size(); ++f) {
+    const double moved = (full.control[f] - perturbed).norm();
+    ASSERT_GT(moved, 1e-3);
+    EXPECT_LT((reduced.control[f] - full.control[f]).norm(), 1e-6 * moved) << "frame " << f;
+    EXPECT_NEAR(reduced.frames[f].ncc_after, full.frames[f].ncc_after, 1e-9);
+  }
+}
+
 // Overlapping windows: with 2-frame windows sharing one frame, 3 frames take 2 windows and
 // the middle frame is solved in both; every frame is refined and moves back.
 TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
