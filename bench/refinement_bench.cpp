@@ -72,10 +72,11 @@ const Initialized& State() {
   return state;
 }
 
-void BM_Refinement(benchmark::State& bench, const char* solver) {
+void BM_Refinement(benchmark::State& bench, const char* solver, bool reduced_blocks) {
   const Initialized& s = State();
   solver::StereoRefinementOptions options;
   if (!ceres::StringToLinearSolverType(solver, &options.solver.linear_solver)) std::abort();
+  options.solver.reduced_correlation_blocks = reduced_blocks;
   options.rounds = 1;
   options.window = kFrames;
   if (const char* env = std::getenv("SUBFLOW_BENCH_THREADS")) options.solver.threads = std::atoi(env);
@@ -95,12 +96,16 @@ void BM_Refinement(benchmark::State& bench, const char* solver) {
   bench.counters["mean_dist_mm"] = 1e3 * s.MeanDistanceToTruth(result.control);
 }
 
-BENCHMARK_CAPTURE(BM_Refinement, sparse_normal_cholesky, "sparse_normal_cholesky")
+// The reference: correlation blocks with all their residuals (the implementation before
+// the reduced form), then every solver on the reduced blocks (the default).
+BENCHMARK_CAPTURE(BM_Refinement, full_blocks_sparse_normal_cholesky, "sparse_normal_cholesky", false)
     ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Refinement, cgnr, "cgnr")->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Refinement, iterative_schur, "iterative_schur")
+BENCHMARK_CAPTURE(BM_Refinement, sparse_normal_cholesky, "sparse_normal_cholesky", true)
     ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Refinement, sparse_schur, "sparse_schur")
+BENCHMARK_CAPTURE(BM_Refinement, cgnr, "cgnr", true)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Refinement, iterative_schur, "iterative_schur", true)
+    ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Refinement, sparse_schur, "sparse_schur", true)
     ->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 }  // namespace

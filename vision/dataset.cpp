@@ -55,10 +55,20 @@ struct Dataset::State {
   std::list<std::pair<Key, cv::Mat>> lru;
   std::map<Key, std::list<std::pair<Key, cv::Mat>>::iterator> index;
 
+  // Per video, two decoders: a pass that walks the frames backwards (motion
+  // initialization's chain before the reference frame) or two passes at once (both chains
+  // run side by side) would otherwise seek the one decoder back and forth, and a seek
+  // decodes from the previous key frame (real captures may have one key frame per take).
   struct VideoReader {
+    struct Decoder {
+      cv::VideoCapture capture;
+      int next_frame = -1;  // frame the capture will return on the next read(); -1 = not open
+      long last_used = 0;
+    };
+    static constexpr int kDecoders = 2;
     std::mutex mutex;
-    cv::VideoCapture capture;
-    int next_frame = -1;  // frame the capture will return on the next read(); -1 = not open
+    Decoder decoders[kDecoders];
+    long reads = 0;
   };
   std::vector<std::unique_ptr<VideoReader>> videos;
 
@@ -102,30 +112,44 @@ struct Dataset::State {
     VideoReader& reader = *videos[camera];
     const std::string& path = layout.video_paths[camera];
     std::lock_guard<std::mutex> lock(reader.mutex);
-    if (reader.next_frame < 0) {
-      if (!reader.capture.open(path))
-        ThrowError(path, "", "cannot open video (expected a file OpenCV's VideoCapture reads)");
-      reader.next_frame = 0;
-    }
     // Seeking may be slow and inexact for some codecs (it decodes from the previous key
     // frame); a short step forward (a subsampled pass over the video) skips frames
-    // without converting them instead.
+    // without converting them instead. The decoder that reaches `frame` by the shortest
+    // such step reads it; if none can, the least recently used one seeks.
     constexpr int kMaxForwardSkip = 64;
-    while (reader.next_frame < frame && frame - reader.next_frame <= kMaxForwardSkip) {
-      if (!reader.capture.grab()) break;
-      ++reader.next_frame;
+    VideoReader::Decoder* chosen = nullptr;
+    for (VideoReader::Decoder& decoder : reader.decoders) {
+      const bool reaches = decoder.next_frame >= 0 && decoder.next_frame <= frame &&
+                           frame - decoder.next_frame <= kMaxForwardSkip;
+      if (reaches && (!chosen || decoder.next_frame > chosen->next_frame)) chosen = &decoder;
     }
-    if (reader.next_frame != frame) {
-      reader.capture.set(cv::CAP_PROP_POS_FRAMES, frame);
-      reader.next_frame = frame;
+    if (!chosen) {
+      chosen = &reader.decoders[0];
+      for (VideoReader::Decoder& decoder : reader.decoders)
+        if (decoder.last_used < chosen->last_used) chosen = &decoder;
+    }
+    VideoReader::Decoder& decoder = *chosen;
+    decoder.last_used = ++reader.reads;
+    if (decoder.next_frame < 0) {
+      if (!decoder.capture.open(path))
+        ThrowError(path, "", "cannot open video (expected a file OpenCV's VideoCapture reads)");
+      decoder.next_frame = 0;
+    }
+    while (decoder.next_frame < frame && frame - decoder.next_frame <= kMaxForwardSkip) {
+      if (!decoder.capture.grab()) break;
+      ++decoder.next_frame;
+    }
+    if (decoder.next_frame != frame) {
+      decoder.capture.set(cv::CAP_PROP_POS_FRAMES, frame);
+      decoder.next_frame = frame;
     }
     cv::Mat image;
-    if (!reader.capture.read(image) || image.empty()) {
-      reader.next_frame = -1;
-      reader.capture.release();
+    if (!decoder.capture.read(image) || image.empty()) {
+      decoder.next_frame = -1;
+      decoder.capture.release();
       ThrowError(path, "frame " + std::to_string(frame), "could not be decoded");
     }
-    reader.next_frame = frame + 1;
+    decoder.next_frame = frame + 1;
     return image;
   }
 };

@@ -1,7 +1,10 @@
 #include "solver/motion/motion_init.h"
 
 #include <cmath>
+#include <mutex>
 #include <string>
+
+#include <tbb/parallel_invoke.h>
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
@@ -105,6 +108,7 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     for (std::size_t k = 0; k < cameras.size(); ++k) loaded[k] = images.gray(static_cast<int>(k), frame);
     return loaded;
   };
+  std::mutex progress_mutex;  // the two chains report one count
   int done = 0;
   ProgressBegin(progress, "motion initialization", static_cast<std::size_t>(frame_count - 1));
   auto propagate = [&](int from, int to, const std::vector<cv::Mat>& from_images,
@@ -144,20 +148,36 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
                   from, to, step.report.constraints, step.report.pruned,
                   step.report.photometric_rms_zero, step.report.photometric_rms,
                   step.report.mean_displacement, step.report.seconds);
+    const std::lock_guard<std::mutex> lock(progress_mutex);
     ProgressUpdate(progress, static_cast<std::size_t>(++done));
   };
   const std::vector<cv::Mat> reference_images = load(reference_frame);
-  std::vector<cv::Mat> current = reference_images;
-  for (int f = reference_frame; f + 1 < frame_count; ++f) {
-    std::vector<cv::Mat> next = load(f + 1);
-    propagate(f, f + 1, current, next);
-    current = std::move(next);
-  }
-  current = reference_images;
-  for (int f = reference_frame; f > 0; --f) {
-    std::vector<cv::Mat> previous = load(f - 1);
-    propagate(f, f - 1, current, previous);
-    current = std::move(previous);
+  auto forward = [&] {
+    std::vector<cv::Mat> current = reference_images;
+    for (int f = reference_frame; f + 1 < frame_count; ++f) {
+      std::vector<cv::Mat> next = load(f + 1);
+      propagate(f, f + 1, current, next);
+      current = std::move(next);
+    }
+  };
+  auto backward = [&] {
+    std::vector<cv::Mat> current = reference_images;
+    for (int f = reference_frame; f > 0; --f) {
+      std::vector<cv::Mat> previous = load(f - 1);
+      propagate(f, f - 1, current, previous);
+      current = std::move(previous);
+    }
+  };
+  // The chains after and before the reference frame share only its images, and each step
+  // is computed as it would be alone (every parallel sum in the step has a fixed order):
+  // side by side, one chain's serial parts (the solver's level loop, ray casts, decoding)
+  // overlap the other's parallel ones. An exception in one (an interrupt, a bad frame) is
+  // rethrown here once the other has stopped too.
+  if (options.concurrent_chains) {
+    tbb::parallel_invoke(forward, backward);
+  } else {
+    forward();
+    backward();
   }
   ProgressEnd(progress);
 

@@ -40,6 +40,10 @@ struct MotionInitOptions {
   // pass, whose targets are the refined shapes — one connectivity whose vertices already
   // follow the material — not for independent per-frame fits (shape initialization's).
   bool guess_from_targets = false;
+  // Run the chains after and before the reference frame side by side (the same result as
+  // one after the other). An implementation choice, not a setting of the method: not in
+  // options files.
+  bool concurrent_chains = true;
 
   void Check() const;  // throws subflow::Error naming the field
 };

@@ -195,6 +195,15 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
   std::printf("mean |flow| %.3f mm, mean |non-rigid flow| %.3f mm\n", 1e3 * mean_flow,
               1e3 * mean_non_rigid);
   EXPECT_LT(mean_non_rigid, 0.2 * mean_flow);
+
+  // The chains after and before the reference frame side by side (the default) or one after
+  // the other: the same numbers, to the bit.
+  MotionInitOptions serial = init;
+  serial.concurrent_chains = false;
+  ASSERT_TRUE(init.concurrent_chains);
+  const MotionInitResult one_after_the_other = InitializeMotion(images_of_frames, scene.hierarchy, fitted, 1, serial);
+  for (int f = 0; f < 3; ++f)
+    EXPECT_EQ((one_after_the_other.control[f] - result.control[f]).cwiseAbs().maxCoeff(), 0.0) << "frame " << f;
 }
 
 // A duplicated frame (capture software repeats a frame when it drops one): frames 0, 1, 1

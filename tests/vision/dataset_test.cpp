@@ -337,6 +337,10 @@ TEST(Dataset, SkipsForwardThroughAVideoWithoutTheCache) {
   // A subsampled pass (skips forward), then a step back (seeks), then forward again.
   for (int f : {0, 3, 4, 8, 2, 7})
     EXPECT_EQ(cv::norm(dataset.Image(0, f), RandomImage(32, 24, CV_8UC3, 70 + f), cv::NORM_INF), 0.0) << f;
+  // Two passes interleaved, one forwards from frame 4 and one backwards from frame 3 (the
+  // motion chains side by side): each read still returns its own frame.
+  for (int f : {4, 3, 5, 2, 6, 1, 7, 0, 8})
+    EXPECT_EQ(cv::norm(dataset.Image(1, f), RandomImage(32, 24, CV_8UC3, 70 + f), cv::NORM_INF), 0.0) << f;
 }
 
 // --- Malformed inputs: one test each, asserting that the message names the file, the
