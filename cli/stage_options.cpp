@@ -141,6 +141,18 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
          },
          "Ceres linear solver type (ceres::LinearSolverType, any case)")
       ->default_str(nlohmann::json(o->solver.linear_solver).get<std::string>());
+  sub->add_option("--iterative-from-unknowns", o->solver.iterative_from_unknowns,
+                  "Windows with at least this many unknowns use --iterative-solver instead (0 = never)")
+      ->capture_default_str();
+  sub->add_option_function<std::string>(
+         "--iterative-solver",
+         [o](const std::string& name) {
+           if (!ceres::StringToLinearSolverType(name, &o->solver.iterative_solver))
+             throw CLI::ValidationError("--iterative-solver", "'" + name + "' is not a Ceres linear solver type "
+                                        "(e.g. cgnr, iterative_schur)");
+         },
+         "Ceres linear solver of the large windows (ceres::LinearSolverType, any case)")
+      ->default_str(nlohmann::json(o->solver.iterative_solver).get<std::string>());
   sub->add_option("--threads", o->solver.threads, "Ceres threads (0 = all cores)")->capture_default_str();
   sub->add_option("--samples-per-pixel", o->samples_per_pixel,
                   "Surface samples per pixel² of a patch's finest view")->capture_default_str();

@@ -124,9 +124,13 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(NormalFlowSolverOptions, smoothness, rigid_in
                                    collinearity_min_cameras, cg_tolerance, cg_reweighting_tolerance,
                                    cg_max_iterations)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solver, image_sigmas)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionInitOptions, step, hull_weight, hull_max_distance, hull_iterations,
-                                   guess_from_targets)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(WindowSolverOptions, linear_solver, max_iterations, threads, function_tolerance)
+// WITH_DEFAULT here and below: options files written before the newest fields existed
+// still load (those fields then take their defaults).
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,
+                                                hull_iterations, guess_from_targets, concurrent_chains)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WindowSolverOptions, linear_solver, max_iterations, threads,
+                                                function_tolerance, iterative_from_unknowns, iterative_solver,
+                                                iterative_eta, reduced_correlation_blocks)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
                                    per_patch_levels, detail_threshold, min_detail_patch_area,
                                    normal_only_from_level, window, window_overlap, rounds, solver,

@@ -203,7 +203,7 @@ nlohmann::json RefinementJson(const solver::StereoRefinementOptions& o, const so
   for (const solver::RefinementLevelReport& l : result.levels)
     levels.push_back({{"level", l.level}, {"dof", l.dof}, {"patches", l.patches},
                       {"active_patches", l.active_patches}, {"active_fraction", l.active_fraction},
-                      {"windows", l.windows},
+                      {"windows", l.windows}, {"iterative_windows", l.iterative_windows},
                       {"parameters", l.parameters}, {"residual_blocks", l.residual_blocks},
                       {"mean_increment", l.mean_increment}, {"iterations", l.iterations},
                       {"seconds", l.seconds}, {"solver_seconds", l.solver_seconds}});

@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev
   libopencv-dev
   libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
+  libopenblas0-pthread  # the BLAS of CHOLMOD (CMakeLists.txt: SYSTEM_BLAS_LIBRARY)
   libtet1.5-dev
   libtbb-dev
   libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev

@@ -41,8 +41,7 @@ struct MotionInitOptions {
   // follow the material — not for independent per-frame fits (shape initialization's).
   bool guess_from_targets = false;
   // Run the chains after and before the reference frame side by side (the same result as
-  // one after the other). An implementation choice, not a setting of the method: not in
-  // options files.
+  // one after the other).
   bool concurrent_chains = true;
 
   void Check() const;  // throws subflow::Error naming the field

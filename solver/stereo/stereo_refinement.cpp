@@ -100,12 +100,14 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   for (int round = 0; round < options.rounds; ++round) {
     report.parameters = 0;
     report.residual_blocks = 0;
+    report.iterative_windows = 0;
     for (std::size_t w = 0; w < windows.size(); ++w) {
       RefinementWindow window = OpenWindow(prepared, hierarchy, images.cameras, options, state->trajectory,
                                            state->result->control, cache, windows[w].first, windows[w].second);
       const WindowSolution solution = SolveWindow(window, bounds);
       report.parameters += solution.parameters;
       report.residual_blocks += solution.residual_blocks;
+      report.iterative_windows += options.solver.Iterative(solution.parameters);
       report.iterations += solution.iterations;
       report.solver_seconds += solution.solver_seconds;
       ApplySolution(hierarchy, level, solution, state, &moved);
@@ -157,13 +159,24 @@ void WindowSolverOptions::Check() const {
   if (max_iterations < 1) ThrowError("stereo refinement options", "solver.max_iterations", "must be ≥ 1");
   if (threads < 0) ThrowError("stereo refinement options", "solver.threads", "must be ≥ 0 (0 = all cores)");
   if (!(function_tolerance > 0)) ThrowError("stereo refinement options", "solver.function_tolerance", "must be > 0");
+  if (!(iterative_eta > 0 && iterative_eta < 1))
+    ThrowError("stereo refinement options", "solver.iterative_eta", "must be in (0, 1)");
+  if (iterative_from_unknowns < 0)
+    ThrowError("stereo refinement options", "solver.iterative_from_unknowns", "must be ≥ 0 (0 = never)");
   std::string why;
   if (!ToCeres().IsValid(&why)) ThrowError("stereo refinement options", "solver", why);
+  if (iterative_from_unknowns > 0 && !ToCeres(iterative_from_unknowns).IsValid(&why))
+    ThrowError("stereo refinement options", "solver.iterative_solver", why);
 }
 
-ceres::Solver::Options WindowSolverOptions::ToCeres() const {
+bool WindowSolverOptions::Iterative(int unknowns) const {
+  return iterative_from_unknowns > 0 && unknowns >= iterative_from_unknowns;
+}
+
+ceres::Solver::Options WindowSolverOptions::ToCeres(int unknowns) const {
   ceres::Solver::Options options;
-  options.linear_solver_type = linear_solver;
+  options.linear_solver_type = Iterative(unknowns) ? iterative_solver : linear_solver;
+  if (Iterative(unknowns)) options.eta = iterative_eta;
   options.max_num_iterations = max_iterations;
   options.num_threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options.minimizer_progress_to_stdout = false;

@@ -76,14 +76,28 @@ struct WindowSolverOptions {
   // 0.0425 / 89 s, 1e-2 → 0.428 mm / 0.0430 / 74 s; bust_front 8 frames, 1e-4 → 1.109 mm
   // / 0.0568 / 39 s, 3e-3 → 1.095 mm / 0.0556 / 29 s.
   double function_tolerance = 3e-3;
+  // Windows with at least this many unknowns use iterative_solver instead of linear_solver
+  // (0 = never). The sparse Cholesky factor of a window fills in with its size (a surface
+  // over several frames): on the real pose2sim take (HD, 3,000–76,000 unknowns a window)
+  // frames 0–11 took 57.7 s in Ceres with sparse_normal_cholesky and 19.3 s with cgnr
+  // (mean NCC after 0.6045 / 0.5995), while on the blob (≤ 4,600 unknowns a window)
+  // cgnr was no faster (37.4 against 37.8 s) and a little less accurate (0.430 against
+  // 0.423 mm P90).
+  int iterative_from_unknowns = 8000;
+  ceres::LinearSolverType iterative_solver = ceres::CGNR;
+  // Its forcing term (Ceres's eta): each step's linear solve stops at this relative
+  // residual. Ceres's default, 0.1, gave pose2sim frames 0–11 a mean NCC of 0.5913
+  // (sparse_normal_cholesky 0.6045) in 19.4 s of Ceres; 0.01 gave 0.6039 in 26.4 s.
+  double iterative_eta = 1e-2;
   // Correlation blocks in their reduced form (PatchCorrelationCost::UseReducedForm): the
   // same steps up to rounding, with an (n + 1) × n Jacobian per block instead of m × n.
-  // An implementation choice, not a setting of the method: not in options files.
   bool reduced_correlation_blocks = true;
 
   void Check() const;  // throws subflow::Error naming the field (and what Ceres objects to)
-  // ceres::Solver::Options with these settings, silent.
-  ceres::Solver::Options ToCeres() const;
+  // ceres::Solver::Options with these settings for a window of `unknowns` scalar unknowns,
+  // silent.
+  ceres::Solver::Options ToCeres(int unknowns = 0) const;
+  bool Iterative(int unknowns) const;  // whether such a window uses iterative_solver
 };
 
 struct StereoRefinementOptions {
@@ -171,6 +185,7 @@ struct RefinementLevelReport {
   double seconds = 0;
   double solver_seconds = 0;   // inside ceres::Solve
   int iterations = 0;          // Ceres iterations over all windows and rounds
+  int iterative_windows = 0;   // windows solved by solver.iterative_solver (last round)
 };
 
 struct RefinementFrameReport {

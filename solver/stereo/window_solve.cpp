@@ -106,7 +106,7 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
   if (problem.NumParameterBlocks() > 0 && problem.NumResidualBlocks() > 0) {
     ceres::Solver::Summary summary;
     const Stopwatch solve_start;
-    ceres::Solve(options.solver.ToCeres(), &problem, &summary);
+    ceres::Solve(options.solver.ToCeres(solution.parameters), &problem, &summary);
     solution.solver_seconds = solve_start.Seconds();
     solution.iterations = static_cast<int>(summary.iterations.size());
     std::string costs;

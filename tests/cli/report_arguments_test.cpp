@@ -142,6 +142,7 @@ std::map<std::string, Case> Cases(const Inputs& in) {
                  {"--motion-smoothness", "0.0041"}, {"--refine-from", "1"},
                  {"--refine-to", "1"}, {"--window", "4"}, {"--window-overlap", "1"}, {"--rounds", "2"},
                  {"--iterations", "3"}, {"--linear-solver", "DENSE_QR"}, {"--threads", "1"},
+                 {"--iterative-from-unknowns", "100"}, {"--iterative-solver", "DENSE_QR"},
                  {"--samples-per-pixel", "0.5"}, {"--max-cameras", "4"}, {"--temporal-weight", "0.5"},
                  {"--silhouette-weight", "0.1"}, {"--membrane-weight", "0.2"}, {"--temporal-smoothness", "0.2"},
                  {"--function-tolerance", "0.004"}}}},

@@ -89,6 +89,8 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--function-tolerance", {"0.01", "/options/refinement/solver/function_tolerance", 0.01}},
       {"--linear-solver", {"DENSE_QR", "/options/refinement/solver/linear_solver", "dense_qr"}},
       {"--threads", {"1", "/options/refinement/solver/threads", 1}},
+      {"--iterative-from-unknowns", {"100", "/options/refinement/solver/iterative_from_unknowns", 100}},
+      {"--iterative-solver", {"DENSE_QR", "/options/refinement/solver/iterative_solver", "dense_qr"}},
       {"--samples-per-pixel", {"0.5", "/options/refinement/samples_per_pixel", 0.5}},
       {"--max-cameras", {"4", "/options/refinement/max_cameras", 4}},
       {"--temporal-weight", {"0.5", "/options/refinement/temporal_weight", 0.5}},

@@ -87,6 +87,32 @@ TEST(StereoRefinement, ReducedCorrelationBlocksTakeTheSameSteps) {
   }
 }
 
+// Windows of at least iterative_from_unknowns unknowns are solved by the iterative solver
+// (with its forcing term), the others by the sparse Cholesky one; 0 = never. On the test
+// scene every window is small, so a threshold of 1 sends them all to CGNR, which still
+// brings the perturbed shape back (its steps are inexact, not different).
+TEST(StereoRefinement, LargeWindowsUseTheIterativeSolver) {
+  WindowSolverOptions solver;
+  ASSERT_GT(solver.iterative_from_unknowns, 0);
+  EXPECT_EQ(solver.ToCeres(solver.iterative_from_unknowns - 1).linear_solver_type, solver.linear_solver);
+  EXPECT_EQ(solver.ToCeres(solver.iterative_from_unknowns).linear_solver_type, solver.iterative_solver);
+  EXPECT_EQ(solver.ToCeres(solver.iterative_from_unknowns).eta, solver.iterative_eta);
+  solver.iterative_from_unknowns = 0;
+  EXPECT_EQ(solver.ToCeres(1 << 30).linear_solver_type, solver.linear_solver);
+
+  const testing::RefinementScene& scene = Scene();
+  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const double before = scene.RmsDistanceToTruth(perturbed);
+  StereoRefinementOptions options = TestOptions();
+  options.solver.iterative_from_unknowns = 1;
+  const RefinementResult result = scene.Refine(perturbed, 2, options);
+  for (const RefinementLevelReport& level : result.levels) EXPECT_EQ(level.iterative_windows, level.windows);
+  for (std::size_t f = 0; f < result.control.size(); ++f)
+    EXPECT_LT(scene.RmsDistanceToTruth(result.control[f]), 0.5 * before) << "frame " << f;
+  const RefinementResult direct = scene.Refine(perturbed, 2, TestOptions());
+  for (const RefinementLevelReport& level : direct.levels) EXPECT_EQ(level.iterative_windows, 0);
+}
+
 // Overlapping windows: with 2-frame windows sharing one frame, 3 frames take 2 windows and
 // the middle frame is solved in both; every frame is refined and moves back.
 TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
@@ -125,6 +151,12 @@ TEST(StereoRefinement, RejectsBadInput) {
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
   options = TestOptions();
   options.solver.function_tolerance = 0.0;
+  EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
+  options = TestOptions();
+  options.solver.iterative_from_unknowns = -1;
+  EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
+  options = TestOptions();
+  options.solver.iterative_eta = 1.0;
   EXPECT_THROW(scene.Refine(scene.scene.control, 1, options), Error);
   Positions bad = scene.scene.control;
   bad(0, 0) = std::nan("");
