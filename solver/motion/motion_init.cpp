@@ -55,15 +55,15 @@ void MotionInitOptions::Check() const {
     ThrowError("motion init", "hull_iterations", "expected 1..20");
 }
 
-MotionInitResult InitializeMotion(const vision::ImageSequence& images,
-                                  const geometry::LoopHierarchy& hierarchy,
-                                  const std::vector<Positions>& initial_control,
-                                  int reference_frame, const MotionInitOptions& options,
-                                  Progress* progress) {
-  const Stopwatch start;
+namespace {
+
+// Checks the inputs of InitializeMotion (throws subflow::Error naming the field); whether
+// `initial_control` has one matrix per frame (else only the reference frame's).
+bool CheckMotionInputs(const vision::ImageSequence& images, const geometry::LoopHierarchy& hierarchy,
+                       const std::vector<Positions>& initial_control, int reference_frame,
+                       const MotionInitOptions& options) {
   options.Check();
   images.Check("motion init");
-  const std::vector<vision::Camera>& cameras = images.cameras;
   const int frame_count = images.frame_count;
   if (frame_count < 1) ThrowError("motion init", "frame count", "expected at least one frame");
   if (reference_frame < 0 || reference_frame >= frame_count)
@@ -74,8 +74,7 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     ThrowError("motion init", "initial control points",
                std::to_string(initial_control.size()) + " matrices, expected 1 (the reference "
                "frame's) or one per frame (" + std::to_string(frame_count) + ")");
-  const int n = hierarchy.finest_level();
-  const Eigen::Index vertices = hierarchy.VertexCount(n);
+  const Eigen::Index vertices = hierarchy.VertexCount(hierarchy.finest_level());
   const Positions& reference = per_frame ? initial_control[reference_frame] : initial_control[0];
   if (reference.rows() != vertices)
     ThrowError("motion init", "initial control points of the reference frame",
@@ -86,6 +85,22 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
       ThrowError("motion init", "initial control points of frame " + std::to_string(f),
                  std::to_string(initial_control[f].rows()) + " rows, expected 0 or " +
                      std::to_string(vertices));
+  return per_frame;
+}
+
+}  // namespace
+
+MotionInitResult InitializeMotion(const vision::ImageSequence& images,
+                                  const geometry::LoopHierarchy& hierarchy,
+                                  const std::vector<Positions>& initial_control,
+                                  int reference_frame, const MotionInitOptions& options,
+                                  Progress* progress) {
+  const Stopwatch start;
+  const bool per_frame = CheckMotionInputs(images, hierarchy, initial_control, reference_frame, options);
+  const std::vector<vision::Camera>& cameras = images.cameras;
+  const int frame_count = images.frame_count;
+  const int n = hierarchy.finest_level();
+  const Positions& reference = per_frame ? initial_control[reference_frame] : initial_control[0];
   auto fitted = [&](int frame) -> const Positions* {
     if (!per_frame || initial_control[frame].rows() == 0) return nullptr;
     return &initial_control[frame];
