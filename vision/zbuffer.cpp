@@ -54,8 +54,8 @@ struct Edge {
 // Draws screen triangles into a ZBuffer (a friend, to write its buffers directly).
 class TriangleRasterizer {
  public:
-  TriangleRasterizer(ZBuffer& zbuffer, bool cull_back_faces)
-      : zbuffer_(zbuffer), cull_back_faces_(cull_back_faces) {}
+  TriangleRasterizer(ZBuffer& zbuffer, const ZBufferOptions& options)
+      : zbuffer_(zbuffer), cull_back_faces_(options.cull_back_faces), depth_only_(options.depth_only) {}
 
   void Draw(const ScreenVertex& a, const ScreenVertex& b_in, const ScreenVertex& c_in, int face) {
     const double area = (b_in.pixel - a.pixel).x() * (c_in.pixel - a.pixel).y() -
@@ -109,6 +109,7 @@ class TriangleRasterizer {
         const std::size_t index = zbuffer_.Index(x, y);
         if (!(depth < zbuffer_.depth_[index])) continue;
         zbuffer_.depth_[index] = static_cast<float>(depth);
+        if (depth_only_) continue;
         zbuffer_.face_[index] = face;
         const double inverse_s = 1.0 / s;
         if (corner_weights) {
@@ -125,7 +126,7 @@ class TriangleRasterizer {
 
  private:
   ZBuffer& zbuffer_;
-  bool cull_back_faces_;
+  bool cull_back_faces_, depth_only_;
 };
 
 void ZBufferOptions::Check() const {
@@ -150,8 +151,8 @@ void ZBuffer::Render(const Camera& camera, const geometry::Positions& V,
   height_ = camera.height();
   const std::size_t pixel_count = static_cast<std::size_t>(width_) * height_;
   depth_.assign(pixel_count, kInfinity);
-  face_.assign(pixel_count, -1);
-  barycentric_.assign(2 * pixel_count, 0.0f);
+  face_.assign(options.depth_only ? 0 : pixel_count, -1);
+  barycentric_.assign(options.depth_only ? 0 : 2 * pixel_count, 0.0f);
 
   const Eigen::Matrix3d& K = camera.K();
   const Eigen::Matrix3d& R = camera.R();
@@ -167,7 +168,7 @@ void ZBuffer::Render(const Camera& camera, const geometry::Positions& V,
     if (camera_points_[i].z() >= near_) pixels_[i] = to_pixel(camera_points_[i]);
   }
 
-  TriangleRasterizer rasterizer(*this, options.cull_back_faces);
+  TriangleRasterizer rasterizer(*this, options);
   ScreenVertex corner[3];
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     const int index[3] = {F(f, 0), F(f, 1), F(f, 2)};
@@ -234,7 +235,7 @@ cv::Mat ZBuffer::Mask() const {
 }
 
 int ZBuffer::CoveredPixelCount() const {
-  return static_cast<int>(std::count_if(face_.begin(), face_.end(), [](int f) { return f >= 0; }));
+  return static_cast<int>(std::count_if(depth_.begin(), depth_.end(), [](float d) { return d < kInfinity; }));
 }
 
 bool ZBuffer::IsVisible(const Eigen::Vector3d& X, double depth_tolerance) const {

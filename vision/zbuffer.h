@@ -35,6 +35,10 @@ struct ZBufferOptions {
   // Skip triangles seen from behind (clockwise on screen for F counter-clockwise from
   // outside). Only for closed meshes seen from outside, where it changes nothing but speed.
   bool cull_back_faces = false;
+  // Depth only (visibility tests): faces and barycentrics are not kept, so Face,
+  // Barycentric and SurfacePoint must not be called; Covered, Mask, Depth and IsVisible
+  // work as always. A quarter of the memory to clear and write per render.
+  bool depth_only = false;
 
   void Check() const;  // throws subflow::Error on nonsense (near ≤ 0, not finite)
 };
@@ -56,7 +60,7 @@ class ZBuffer {
 
   float Depth(int x, int y) const { return depth_[Index(x, y)]; }
   int Face(int x, int y) const { return face_[Index(x, y)]; }
-  bool Covered(int x, int y) const { return face_[Index(x, y)] >= 0; }
+  bool Covered(int x, int y) const { return depth_[Index(x, y)] < std::numeric_limits<float>::infinity(); }
   Eigen::Vector2f Barycentric(int x, int y) const {
     const std::size_t i = Index(x, y);
     return {barycentric_[2 * i], barycentric_[2 * i + 1]};
@@ -65,7 +69,8 @@ class ZBuffer {
   Eigen::Vector3d SurfacePoint(int x, int y, const geometry::Positions& V,
                                const geometry::Faces& F) const;
 
-  // Raw buffers (row-major, width·height entries; barycentrics 2 per pixel: u, v).
+  // Raw buffers (row-major, width·height entries; barycentrics 2 per pixel: u, v; faces
+  // and barycentrics empty after a depth-only render).
   const std::vector<float>& depth() const { return depth_; }
   const std::vector<int>& faces() const { return face_; }
   const std::vector<float>& barycentrics() const { return barycentric_; }

@@ -197,60 +197,66 @@ NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
     return e;
   };
   const int samples = static_cast<int>(L.rows());
-  stencils.sample_pair_offset.assign(samples + 1, 0);
+  // Each sample's stencil pairs p ≤ q: their pattern entry (in parallel), then the entries'
+  // rows by a counting sort in sample order.
+  std::vector<long> sample_pair_offset(samples + 1, 0);
   for (int s = 0; s < samples; ++s) {
-    const int k = L.outerIndexPtr()[s + 1] - L.outerIndexPtr()[s];
-    stencils.sample_pair_offset[s + 1] = stencils.sample_pair_offset[s] + k * (k + 1) / 2;
+    const long k = L.outerIndexPtr()[s + 1] - L.outerIndexPtr()[s];
+    sample_pair_offset[s + 1] = sample_pair_offset[s] + k * (k + 1) / 2;
   }
-  stencils.pair_entry.resize(stencils.sample_pair_offset.back());
+  std::vector<int> pair_entry(static_cast<std::size_t>(sample_pair_offset.back()));
   tbb::parallel_for(0, samples, [&](int s) {
     const int begin = L.outerIndexPtr()[s], k = L.outerIndexPtr()[s + 1] - begin;
     const int* columns = L.innerIndexPtr() + begin;
-    int* pairs = stencils.pair_entry.data() + stencils.sample_pair_offset[s];
+    int* pairs = pair_entry.data() + sample_pair_offset[s];
     for (int p = 0; p < k; ++p)
       for (int q = p; q < k; ++q)
         *pairs++ = entry(std::min(columns[p], columns[q]), std::max(columns[p], columns[q]));
   });
+  const int entries = stencils.pattern.entries();
+  geometry::SparseMatrix& E = stencils.entry_weights;
+  E.resize(entries, samples);
+  E.resizeNonZeros(static_cast<Eigen::Index>(pair_entry.size()));
+  int* outer = E.outerIndexPtr();
+  std::fill(outer, outer + entries + 1, 0);
+  for (int e : pair_entry) ++outer[e + 1];
+  for (int e = 0; e < entries; ++e) outer[e + 1] += outer[e];
+  std::vector<int> fill(outer, outer + entries);
+  const int* pairs = pair_entry.data();
+  for (int s = 0; s < samples; ++s) {
+    const int begin = L.outerIndexPtr()[s], k = L.outerIndexPtr()[s + 1] - begin;
+    const double* l = L.valuePtr() + begin;
+    for (int p = 0; p < k; ++p)
+      for (int q = p; q < k; ++q) {
+        const int slot = fill[*pairs++]++;
+        E.innerIndexPtr()[slot] = s;
+        E.valuePtr()[slot] = l[p] * l[q];
+      }
+  }
   return stencils;
 }
 
 std::vector<double> NormalFlowSolver::DataSums(
     const SampleStencils& stencils, const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M) {
-  const geometry::SparseMatrix& L = stencils.limit;
-  const int samples = static_cast<int>(L.rows());
-  const std::size_t entries = static_cast<std::size_t>(stencils.pattern.entries());
   // Block (a, b) of N = Σ_s L_sᵀ L_s ⊗ M_s is Σ_s l_sa l_sb M_s: symmetric, and equal to
-  // block (b, a). Only the upper pattern entries (row ≤ column) accumulate, 6 values each.
-  auto add_samples = [&](int first, int last, double* sums) {
-    for (int s = first; s < last; ++s) {
-      const double* m6 = M.row(s).data();
-      if (m6[0] == 0.0 && m6[3] == 0.0 && m6[5] == 0.0) continue;
-      const int begin = L.outerIndexPtr()[s], k = L.outerIndexPtr()[s + 1] - begin;
-      const double* l = L.valuePtr() + begin;
-      const int* pairs = stencils.pair_entry.data() + stencils.sample_pair_offset[s];
-      for (int p = 0; p < k; ++p)
-        for (int q = p; q < k; ++q) {
-          const double w = l[p] * l[q];
-          double* sum = sums + 6 * static_cast<std::size_t>(*pairs++);
-          for (int i = 0; i < 6; ++i) sum[i] += w * m6[i];
-        }
+  // block (b, a). Only the upper pattern entries (row ≤ column) hold sums, 6 values each,
+  // gathered entry by entry in parallel (each entry's samples added in ascending order:
+  // deterministic, no per-thread copies of the sums to clear and add up).
+  const geometry::SparseMatrix& E = stencils.entry_weights;
+  std::vector<double> sums(6 * static_cast<std::size_t>(E.rows()), 0.0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(E.rows()), 4096),
+                    [&](const tbb::blocked_range<int>& range) {
+    for (int e = range.begin(); e < range.end(); ++e) {
+      double sum[6] = {0, 0, 0, 0, 0, 0};
+      for (int k = E.outerIndexPtr()[e]; k < E.outerIndexPtr()[e + 1]; ++k) {
+        const double w = E.valuePtr()[k];
+        const double* m6 = M.row(E.innerIndexPtr()[k]).data();
+        for (int i = 0; i < 6; ++i) sum[i] += w * m6[i];
+      }
+      std::copy(sum, sum + 6, sums.data() + 6 * static_cast<std::size_t>(e));
     }
-  };
-  // Parallel over a fixed split of the samples, each part into its own sums, added in
-  // part order (deterministic). The parts are few: their sums (6 per pattern entry of
-  // level hi, not the finest level) cost less than the scatter they parallelize.
-  const int part_count = std::clamp(samples / 8192, 1, 4);
-  std::vector<std::vector<double>> partial(part_count);
-  tbb::parallel_for(0, part_count, [&](int part) {
-    partial[part].assign(6 * entries, 0.0);
-    add_samples(static_cast<int>(static_cast<long>(samples) * part / part_count),
-                static_cast<int>(static_cast<long>(samples) * (part + 1) / part_count),
-                partial[part].data());
   });
-  for (int part = 1; part < part_count; ++part)
-    for (std::size_t i = 0; i < partial[0].size(); ++i) partial[0][i] += partial[part][i];
-
-  return std::move(partial[0]);
+  return sums;
 }
 
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {

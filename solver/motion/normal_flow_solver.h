@@ -174,9 +174,9 @@ class NormalFlowSolver {
   struct SampleStencils {
     geometry::SparseMatrix limit;        // L_hi, row-major
     SymmetricPattern pattern;            // of L_hiᵀ L_hi (#V(hi) square)
-    // Per sample, per stencil pair p ≤ q: the pattern entry (min, max) of their columns.
-    std::vector<int> pair_entry;
-    std::vector<int> sample_pair_offset; // #S + 1 offsets into pair_entry
+    // Row e = (a, b), a ≤ b, of the pattern: l_sa l_sb in the column of every sample s
+    // whose stencil holds both (row-major, samples ascending; lower entries' rows empty).
+    geometry::SparseMatrix entry_weights;
   };
   // Drops the rounding-noise entries of `limit` and builds the pair pattern.
   static SampleStencils MakeStencils(const geometry::SparseMatrix& limit);

@@ -87,7 +87,10 @@ SampleVisibility VisibilityTester::Compute(const std::vector<vision::Camera>& ca
   result.visible.assign(cameras.size(), std::vector<std::uint8_t>(sample_count, 0));
   tbb::parallel_for(std::size_t{0}, cameras.size(), [&](std::size_t k) {
     const vision::Camera& camera = cameras[k];
-    const vision::ZBuffer zbuffer(camera, mesh.V, mesh.F);
+    thread_local vision::ZBuffer zbuffer;  // its buffers reused from render to render
+    vision::ZBufferOptions depth_only;
+    depth_only.depth_only = true;
+    zbuffer.Render(camera, mesh.V, mesh.F, depth_only);
     const Eigen::Vector3d centre = camera.Center();
     std::vector<std::uint8_t>& visible = result.visible[k];
     for (int s = 0; s < sample_count; ++s) {

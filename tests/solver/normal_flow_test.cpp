@@ -104,6 +104,29 @@ TEST(SampleVisibility, BackFacingSamplesAreHiddenFrontFacingSeen) {
   EXPECT_EQ(static_cast<int>(patch_cameras.size()), scene.hierarchy.FaceCount(n));
 }
 
+// The z-buffer of the level's own faces (density 1, the default) decides as a finer
+// tessellation does: the facets' chord error is far below the depth tolerance.
+TEST(SampleVisibility, OneTriangleAFaceDecidesAsAFinerTessellation) {
+  const MotionTestScene& scene = Scene();
+  const int n = scene.hierarchy.finest_level();
+  const SurfaceSamples samples = SampleLimitSurface(scene.hierarchy, n, scene.control, scene.cameras, {});
+  const Positions X = samples.SamplePositions(scene.control);
+  const Positions normals = samples.SampleNormals(scene.control);
+  VisibilityOptions fine;
+  fine.tessellation_density = 4;
+  const SampleVisibility coarse = VisibilityTester(scene.hierarchy, n).Compute(scene.cameras, scene.control, X, normals);
+  const SampleVisibility reference =
+      VisibilityTester(scene.hierarchy, n, fine).Compute(scene.cameras, scene.control, X, normals);
+  int differ = 0, visible = 0;
+  for (int k = 0; k < coarse.camera_count(); ++k)
+    for (int s = 0; s < samples.size(); ++s) {
+      differ += coarse.visible[k][s] != reference.visible[k][s];
+      visible += reference.visible[k][s];
+    }
+  EXPECT_GT(visible, samples.size());
+  EXPECT_LE(differ, 0.002 * visible) << differ << " of " << visible;
+}
+
 // On a linear ramp I = a x + b y + c the smoothed gradient is exact (a Gaussian and a
 // central difference preserve linear functions) away from the border, and I_t of a ramp
 // shifted by d pixels per frame is −(a, b)·d (central and one-sided differences alike).

@@ -235,6 +235,29 @@ TEST(ZBuffer, BackFaceCullingChangesNothingOnAClosedSurface) {
   EXPECT_EQ(all.faces(), culled.faces());
 }
 
+TEST(ZBuffer, DepthOnlyRenderKeepsTheDepthsAndCoverageAndReusesItsBuffers) {
+  const TriangleMesh mesh = BumpySphere(4, Eigen::Vector3d(0.01, -0.02, 0.015));
+  const Camera camera = TestCamera();
+  const ZBuffer full(camera, mesh.V, mesh.F);
+  ZBufferOptions depth_only;
+  depth_only.depth_only = true;
+  ZBuffer depth(TestCamera(160, 120), mesh.V, mesh.F);  // a full render of another size first
+  depth.Render(camera, mesh.V, mesh.F, depth_only);
+  EXPECT_EQ(depth.depth(), full.depth());
+  EXPECT_TRUE(depth.faces().empty());
+  EXPECT_TRUE(depth.barycentrics().empty());
+  EXPECT_EQ(depth.CoveredPixelCount(), full.CoveredPixelCount());
+  EXPECT_GT(full.CoveredPixelCount(), 1000);
+  EXPECT_EQ(cv::countNonZero(depth.Mask() != full.Mask()), 0);
+  int agree = 0;
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i) {
+    const Eigen::Vector3d X = mesh.V.row(i).transpose();
+    EXPECT_EQ(depth.IsVisible(X, 1e-3), full.IsVisible(X, 1e-3));
+    agree += full.IsVisible(X, 1e-3);
+  }
+  EXPECT_GT(agree, 100);
+}
+
 TEST(ZBuffer, VisibilityOfSurfacePoints) {
   // Vertices of a sphere: visible iff on the camera's side of the tangent cone
   // (n · (C − X) > 0). Near the outline (|facing| < 0.2) the discrete silhouette decides,
