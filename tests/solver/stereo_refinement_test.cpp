@@ -2,6 +2,7 @@
 // the images are rendered from the limit surface of known control points, so the true
 // shape is representable. The true shape must be (nearly) a stationary point of the
 // functional, and a shape perturbed along its normals must move back towards it.
+#include <string>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -99,6 +100,10 @@ TEST(StereoRefinement, LargeWindowsUseTheIterativeSolver) {
   EXPECT_EQ(solver.ToCeres(solver.iterative_from_unknowns).eta, solver.iterative_eta);
   solver.iterative_from_unknowns = 0;
   EXPECT_EQ(solver.ToCeres(1 << 30).linear_solver_type, solver.linear_solver);
+  // No projected line search (it re-evaluated the full step's cost every iteration).
+  EXPECT_EQ(solver.ToCeres(1).max_num_line_search_step_size_iterations, 0);
+  std::string why;
+  EXPECT_TRUE(solver.ToCeres(1).IsValid(&why)) << why;
 
   const testing::RefinementScene& scene = Scene();
   const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
