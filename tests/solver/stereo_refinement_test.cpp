@@ -2,8 +2,8 @@
 // the images are rendered from the limit surface of known control points, so the true
 // shape is representable. The true shape must be (nearly) a stationary point of the
 // functional, and a shape perturbed along its normals must move back towards it.
-#include <string>
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
