@@ -107,7 +107,7 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
       const WindowSolution solution = SolveWindow(window, bounds);
       report.parameters += solution.parameters;
       report.residual_blocks += solution.residual_blocks;
-      report.iterative_windows += options.solver.Iterative(solution.parameters);
+      report.iterative_windows += solution.iterative;
       report.iterations += solution.iterations;
       report.solver_seconds += solution.solver_seconds;
       ApplySolution(hierarchy, level, solution, state, &moved);
