@@ -117,6 +117,25 @@ void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o) {
       ->capture_default_str();
 }
 
+namespace {
+
+// Option `name`: a ceres::LinearSolverType by Ceres's name (any case) into `*type`, whose
+// value is the default shown; a name Ceres does not know is refused, naming `examples`.
+void AddLinearSolverOption(CLI::App* sub, const std::string& name, ceres::LinearSolverType* type,
+                           const std::string& examples, const std::string& description) {
+  sub->add_option_function<std::string>(
+         name,
+         [name, type, examples](const std::string& value) {
+           if (!ceres::StringToLinearSolverType(value, type))
+             throw CLI::ValidationError(name, "'" + value + "' is not a Ceres linear solver type (e.g. " +
+                                                  examples + ")");
+         },
+         description)
+      ->default_str(nlohmann::json(*type).get<std::string>());
+}
+
+}  // namespace
+
 void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
   sub->add_option("--refine-from", o->coarsest_level, "Coarsest level refined by stereo")
       ->capture_default_str();
@@ -132,27 +151,14 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
   sub->add_option("--function-tolerance", o->solver.function_tolerance,
                   "A window's solve ends when an iteration lowers the cost by less than this fraction")
       ->capture_default_str();
-  sub->add_option_function<std::string>(
-         "--linear-solver",
-         [o](const std::string& name) {
-           if (!ceres::StringToLinearSolverType(name, &o->solver.linear_solver))
-             throw CLI::ValidationError("--linear-solver", "'" + name + "' is not a Ceres linear solver type "
-                                        "(e.g. sparse_normal_cholesky, sparse_schur, iterative_schur, cgnr, dense_qr)");
-         },
-         "Ceres linear solver type (ceres::LinearSolverType, any case)")
-      ->default_str(nlohmann::json(o->solver.linear_solver).get<std::string>());
+  AddLinearSolverOption(sub, "--linear-solver", &o->solver.linear_solver,
+                        "sparse_normal_cholesky, sparse_schur, iterative_schur, cgnr, dense_qr",
+                        "Ceres linear solver type (ceres::LinearSolverType, any case)");
   sub->add_option("--iterative-from-unknowns", o->solver.iterative_from_unknowns,
                   "Windows with at least this many unknowns use --iterative-solver instead (0 = never)")
       ->capture_default_str();
-  sub->add_option_function<std::string>(
-         "--iterative-solver",
-         [o](const std::string& name) {
-           if (!ceres::StringToLinearSolverType(name, &o->solver.iterative_solver))
-             throw CLI::ValidationError("--iterative-solver", "'" + name + "' is not a Ceres linear solver type "
-                                        "(e.g. cgnr, iterative_schur)");
-         },
-         "Ceres linear solver of the large windows (ceres::LinearSolverType, any case)")
-      ->default_str(nlohmann::json(o->solver.iterative_solver).get<std::string>());
+  AddLinearSolverOption(sub, "--iterative-solver", &o->solver.iterative_solver, "cgnr, iterative_schur",
+                        "Ceres linear solver of the large windows (ceres::LinearSolverType, any case)");
   sub->add_option("--threads", o->solver.threads, "Ceres threads (0 = all cores)")->capture_default_str();
   sub->add_option("--samples-per-pixel", o->samples_per_pixel,
                   "Surface samples per pixel² of a patch's finest view")->capture_default_str();

@@ -167,20 +167,13 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     ProgressUpdate(progress, static_cast<std::size_t>(++done));
   };
   const std::vector<cv::Mat> reference_images = load(reference_frame);
-  auto forward = [&] {
+  // The chain from the reference frame to the last frame (direction +1) or to the first (-1).
+  auto chain = [&](int direction) {
     std::vector<cv::Mat> current = reference_images;
-    for (int f = reference_frame; f + 1 < frame_count; ++f) {
-      std::vector<cv::Mat> next = load(f + 1);
-      propagate(f, f + 1, current, next);
+    for (int f = reference_frame; f + direction >= 0 && f + direction < frame_count; f += direction) {
+      std::vector<cv::Mat> next = load(f + direction);
+      propagate(f, f + direction, current, next);
       current = std::move(next);
-    }
-  };
-  auto backward = [&] {
-    std::vector<cv::Mat> current = reference_images;
-    for (int f = reference_frame; f > 0; --f) {
-      std::vector<cv::Mat> previous = load(f - 1);
-      propagate(f, f - 1, current, previous);
-      current = std::move(previous);
     }
   };
   // The chains after and before the reference frame share only its images, and each step
@@ -189,10 +182,10 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   // overlap the other's parallel ones. An exception in one (an interrupt, a bad frame) is
   // rethrown here once the other has stopped too.
   if (options.concurrent_chains) {
-    tbb::parallel_invoke(forward, backward);
+    tbb::parallel_invoke([&] { chain(+1); }, [&] { chain(-1); });
   } else {
-    forward();
-    backward();
+    chain(+1);
+    chain(-1);
   }
   ProgressEnd(progress);
 

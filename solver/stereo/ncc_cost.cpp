@@ -300,6 +300,9 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
   gradient.noalias() = J.transpose() * r;
   const double largest = normal.diagonal().maxCoeff();
   thread_local Eigen::MatrixXd shifted, factor;  // JᵀJ + δI; Lᵀ (upper triangular)
+  // Reused by compute(), which keeps its storage while the size is unchanged, rather than a
+  // new decomposition (and its n × n matrix) per evaluation.
+  thread_local Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> cholesky;
   factor.setZero(unknowns, unknowns);
   reduced.setZero();
   if (largest > 0.0) {
@@ -307,7 +310,7 @@ bool PatchCorrelationCost::Evaluate(double const* const* parameters, double* res
     for (double jitter = 1e-12 * largest; jitter <= 1e-6 * largest; jitter *= 1e3) {
       shifted = normal;
       shifted.diagonal().array() += jitter;
-      Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> cholesky(shifted);
+      cholesky.compute(shifted);
       if (cholesky.info() != Eigen::Success) continue;
       reduced.head(unknowns) = cholesky.matrixL().solve(gradient);
       factor = cholesky.matrixU();

@@ -62,28 +62,28 @@ PatchCorrelationCost* CorrelationCost(RefinementWindow& window, int face, const 
   const PatchStencil& stencil = window.sampling->stencil[face];
   const std::vector<int>& support = window.sampling->support[face];
   const double epsilon = window.options->ncc_epsilon;
+  PatchCorrelationCost* cost = nullptr;
   if (!window.views) {
     std::vector<PatchView> own;
     for (const ViewKey& key : views) own.push_back(MakeView(window, key.frame, key.camera, face, key.first_block));
-    auto* cost = new PatchCorrelationCost(stencil, std::move(own), std::move(pairs), block_count, window.dof, epsilon);
-    if (window.options->solver.reduced_correlation_blocks) cost->UseReducedForm();
-    return cost;
+    cost = new PatchCorrelationCost(stencil, std::move(own), std::move(pairs), block_count, window.dof, epsilon);
+  } else {
+    const std::vector<std::vector<int>> rows =
+        RowsOfViews(pairs, static_cast<int>(views.size()), static_cast<int>(stencil.rows()));
+    std::vector<const SampledView*> sampled;
+    std::vector<int> first_blocks;
+    for (std::size_t v = 0; v < views.size(); ++v) {
+      const ViewKey& key = views[v];
+      std::vector<const double*> increments;
+      for (int vertex : support) increments.push_back(window.Increment(key.frame, vertex));
+      sampled.push_back(window.views->Add(
+          key.frame, key.camera, face, stencil, [&] { return MakeView(window, key.frame, key.camera, face, 0); },
+          std::move(increments), rows[v]));
+      first_blocks.push_back(key.first_block);
+    }
+    cost = new PatchCorrelationCost(std::move(sampled), std::move(first_blocks), std::move(pairs),
+                                    static_cast<int>(support.size()), block_count, window.dof, epsilon);
   }
-  const std::vector<std::vector<int>> rows =
-      RowsOfViews(pairs, static_cast<int>(views.size()), static_cast<int>(stencil.rows()));
-  std::vector<const SampledView*> sampled;
-  std::vector<int> first_blocks;
-  for (std::size_t v = 0; v < views.size(); ++v) {
-    const ViewKey& key = views[v];
-    std::vector<const double*> increments;
-    for (int vertex : support) increments.push_back(window.Increment(key.frame, vertex));
-    sampled.push_back(window.views->Add(
-        key.frame, key.camera, face, stencil, [&] { return MakeView(window, key.frame, key.camera, face, 0); },
-        std::move(increments), rows[v]));
-    first_blocks.push_back(key.first_block);
-  }
-  auto* cost = new PatchCorrelationCost(std::move(sampled), std::move(first_blocks), std::move(pairs),
-                                        static_cast<int>(support.size()), block_count, window.dof, epsilon);
   if (window.options->solver.reduced_correlation_blocks) cost->UseReducedForm();
   return cost;
 }

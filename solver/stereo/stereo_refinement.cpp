@@ -107,7 +107,7 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
       const WindowSolution solution = SolveWindow(window, bounds);
       report.parameters += solution.parameters;
       report.residual_blocks += solution.residual_blocks;
-      report.iterative_windows += options.solver.Iterative(solution.parameters);
+      report.iterative_windows += solution.iterative;
       report.iterations += solution.iterations;
       report.solver_seconds += solution.solver_seconds;
       ApplySolution(hierarchy, level, solution, state, &moved);
@@ -175,8 +175,9 @@ bool WindowSolverOptions::Iterative(int unknowns) const {
 
 ceres::Solver::Options WindowSolverOptions::ToCeres(int unknowns) const {
   ceres::Solver::Options options;
-  options.linear_solver_type = Iterative(unknowns) ? iterative_solver : linear_solver;
-  if (Iterative(unknowns)) options.eta = iterative_eta;
+  const bool iterative = Iterative(unknowns);
+  options.linear_solver_type = iterative ? iterative_solver : linear_solver;
+  if (iterative) options.eta = iterative_eta;
   options.max_num_iterations = max_iterations;
   options.num_threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   options.minimizer_progress_to_stdout = false;

@@ -105,6 +105,7 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
   Evaluate(problem, silhouette, false, options.silhouette_weight, frames, &silhouette_before, &silhouette_count);
   if (problem.NumParameterBlocks() > 0 && problem.NumResidualBlocks() > 0) {
     ceres::Solver::Summary summary;
+    solution.iterative = options.solver.Iterative(solution.parameters);  // as ToCeres chooses
     const Stopwatch solve_start;
     ceres::Solve(options.solver.ToCeres(solution.parameters), &problem, &summary);
     solution.solver_seconds = solve_start.Seconds();

@@ -36,6 +36,9 @@ struct WindowSolution {
   int parameters = 0;       // free scalar unknowns
   int residual_blocks = 0;
   int iterations = 0;       // Ceres iterations
+  // Solved by options.solver.iterative_solver (else by linear_solver, or not at all: a
+  // window without unknowns or residuals is not solved).
+  bool iterative = false;
   double solver_seconds = 0;  // inside ceres::Solve
 };
 

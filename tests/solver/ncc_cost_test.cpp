@@ -65,6 +65,20 @@ struct Fixture {
   }
 };
 
+// Three views of the patch on linear images (a third camera sees image a again) compared
+// by three pairs on overlapping rows with different weights: 9 + 5 + 5 = 19 residuals on
+// 3 blocks of dof 1. The views point into the fixture, which is therefore not copied.
+struct ThreeViewFixture : Fixture {
+  vision::Camera camera_c = vision::LookAtCamera("c", 200, 160, 300.0, {0.0, -0.1, 1.0}, {0, 0, 0});
+  std::vector<PatchView> views = {View(camera_a, image_a, 0), View(camera_b, image_b, 0), View(camera_c, image_a, 0)};
+  std::vector<CorrelationPair> pairs = {{0, 1, {0, 1, 2, 3, 4, 5, 6, 7, 8}, 0.9},
+                                        {0, 2, {1, 2, 4, 5, 7}, 0.5},
+                                        {1, 2, {0, 3, 6, 7, 8}, 0.25}};
+
+  ThreeViewFixture() : Fixture(1, true) {}
+  ThreeViewFixture(const ThreeViewFixture&) = delete;
+};
+
 // Central differences of a cost function's residuals w.r.t. every parameter.
 void ExpectJacobiansMatch(const ceres::CostFunction& cost, std::vector<double*> blocks,
                           double step, double tolerance) {
@@ -177,25 +191,18 @@ TEST(PatchCorrelationCost, AnalyticJacobianMatchesNumeric) {
 
 // Several pairs in one block: each pair normalized on its own rows, residuals concatenated.
 TEST(PatchCorrelationCost, MultiplePairsAddUpAndDifferentiate) {
-  Fixture fixture(1, true);
-  const vision::Camera camera_c = vision::LookAtCamera("c", 200, 160, 300.0, {0.0, -0.1, 1.0}, {0, 0, 0});
-  const std::vector<PatchView> views = {fixture.View(fixture.camera_a, fixture.image_a, 0),
-                                        fixture.View(fixture.camera_b, fixture.image_b, 0),
-                                        fixture.View(camera_c, fixture.image_a, 0)};
-  const std::vector<CorrelationPair> pairs = {{0, 1, {0, 1, 2, 3, 4, 5, 6, 7, 8}, 0.9},
-                                              {0, 2, {1, 2, 4, 5, 7}, 0.5},
-                                              {1, 2, {0, 3, 6, 7, 8}, 0.25}};
-  const PatchCorrelationCost cost(fixture.stencil, views, pairs, 3, 1, 0.0);
+  const ThreeViewFixture fixture;
+  const PatchCorrelationCost cost(fixture.stencil, fixture.views, fixture.pairs, 3, 1, 0.0);
   ASSERT_EQ(cost.num_residuals(), 19);
   std::vector<double> params = fixture.parameters;
   const double* blocks[3] = {params.data(), params.data() + 1, params.data() + 2};
   Eigen::VectorXd r(19);
   ASSERT_TRUE(cost.Evaluate(blocks, r.data(), nullptr));
   double expected = 0.0;
-  for (const CorrelationPair& pair : pairs) {
+  for (const CorrelationPair& pair : fixture.pairs) {
     Eigen::VectorXd xa, xb;
-    SampleView(views[pair.a], fixture.stencil, 1, blocks, &xa, nullptr);
-    SampleView(views[pair.b], fixture.stencil, 1, blocks, &xb, nullptr);
+    SampleView(fixture.views[pair.a], fixture.stencil, 1, blocks, &xa, nullptr);
+    SampleView(fixture.views[pair.b], fixture.stencil, 1, blocks, &xb, nullptr);
     Eigen::VectorXd ya(pair.rows.size()), yb(pair.rows.size());
     for (std::size_t i = 0; i < pair.rows.size(); ++i) {
       ya(i) = xa(pair.rows[i]);
@@ -208,26 +215,19 @@ TEST(PatchCorrelationCost, MultiplePairsAddUpAndDifferentiate) {
   EXPECT_NEAR(r.squaredNorm(), expected, 1e-12);
   ExpectJacobiansMatch(cost, {params.data(), params.data() + 1, params.data() + 2}, 1e-5, 2e-4);
   // Bad pairs are refused.
-  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, views, {{0, 0, {0, 1}, 1.0}}, 3, 1, 0.0), Error);
-  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, views, {{0, 3, {0, 1}, 1.0}}, 3, 1, 0.0), Error);
-  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, views, {{0, 1, {0, 9}, 1.0}}, 3, 1, 0.0), Error);
-  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, views, {}, 3, 1, 0.0), Error);
+  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, fixture.views, {{0, 0, {0, 1}, 1.0}}, 3, 1, 0.0), Error);
+  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, fixture.views, {{0, 3, {0, 1}, 1.0}}, 3, 1, 0.0), Error);
+  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, fixture.views, {{0, 1, {0, 9}, 1.0}}, 3, 1, 0.0), Error);
+  EXPECT_THROW(PatchCorrelationCost(fixture.stencil, fixture.views, {}, 3, 1, 0.0), Error);
 }
 
 // The reduced form (UseReducedForm): n + 1 residuals instead of m with the same squared
 // norm, normal matrix JᵀJ and gradient Jᵀr as the full block, so Ceres takes the same
 // steps; the pairs' own residuals stay readable; blocks with m ≤ n + 1 are left as they are.
 TEST(PatchCorrelationCost, ReducedFormKeepsTheNormalEquationsAndTheCost) {
-  Fixture fixture(1, true);
-  const vision::Camera camera_c = vision::LookAtCamera("c", 200, 160, 300.0, {0.0, -0.1, 1.0}, {0, 0, 0});
-  const std::vector<PatchView> views = {fixture.View(fixture.camera_a, fixture.image_a, 0),
-                                        fixture.View(fixture.camera_b, fixture.image_b, 0),
-                                        fixture.View(camera_c, fixture.image_a, 0)};
-  const std::vector<CorrelationPair> pairs = {{0, 1, {0, 1, 2, 3, 4, 5, 6, 7, 8}, 0.9},
-                                              {0, 2, {1, 2, 4, 5, 7}, 0.5},
-                                              {1, 2, {0, 3, 6, 7, 8}, 0.25}};
-  const PatchCorrelationCost full(fixture.stencil, views, pairs, 3, 1, 0.01);
-  PatchCorrelationCost reduced(fixture.stencil, views, pairs, 3, 1, 0.01);
+  const ThreeViewFixture fixture;
+  const PatchCorrelationCost full(fixture.stencil, fixture.views, fixture.pairs, 3, 1, 0.01);
+  PatchCorrelationCost reduced(fixture.stencil, fixture.views, fixture.pairs, 3, 1, 0.01);
   reduced.UseReducedForm();
   ASSERT_TRUE(reduced.reduced());
   ASSERT_EQ(full.num_residuals(), 19);

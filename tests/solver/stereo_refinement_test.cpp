@@ -2,6 +2,7 @@
 // the images are rendered from the limit surface of known control points, so the true
 // shape is representable. The true shape must be (nearly) a stationary point of the
 // functional, and a shape perturbed along its normals must move back towards it.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -9,6 +10,7 @@
 
 #include "core/error.h"
 #include "solver/stereo/stereo_refinement.h"
+#include "solver/stereo/window_solve.h"
 #include "tests/solver/refinement_test_scene.h"
 
 namespace subflow::solver {
@@ -116,6 +118,25 @@ TEST(StereoRefinement, LargeWindowsUseTheIterativeSolver) {
     EXPECT_LT(scene.RmsDistanceToTruth(result.control[f]), 0.5 * before) << "frame " << f;
   const RefinementResult direct = scene.Refine(perturbed, 2, TestOptions());
   for (const RefinementLevelReport& level : direct.levels) EXPECT_EQ(level.iterative_windows, 0);
+}
+
+// A window says which linear solver it was solved by (RefineLevel counts the iterative ones
+// from that): with a threshold of 1 unknown the iterative one; a window with nothing to
+// solve (no active patch or vertex) is solved by none, so it is not iterative.
+TEST(StereoRefinement, WindowsRecordTheirLinearSolver) {
+  StereoRefinementOptions options = TestOptions();
+  options.solver.threads = 2;
+  options.solver.iterative_from_unknowns = 1;
+  testing::OpenedWindow solved(Scene(), Scene().scene.control, 1, 1, 0, 0, options);
+  const WindowSolution solution = SolveWindow(solved.window, Scene().bounds);
+  EXPECT_GT(solution.parameters, 0);
+  EXPECT_TRUE(solution.iterative);
+  testing::OpenedWindow idle(Scene(), Scene().scene.control, 1, 1, 0, 0, options);
+  std::fill(idle.window.active_faces.begin(), idle.window.active_faces.end(), 0);
+  std::fill(idle.window.active_vertices.begin(), idle.window.active_vertices.end(), 0);
+  const WindowSolution nothing = SolveWindow(idle.window, Scene().bounds);
+  EXPECT_EQ(nothing.residual_blocks, 0);
+  EXPECT_FALSE(nothing.iterative);
 }
 
 // Overlapping windows: with 2-frame windows sharing one frame, 3 frames take 2 windows and
