@@ -48,6 +48,21 @@ class BlockJacobiPreconditioner {
     return *this;
   }
 
+  // From a matrix in block form (conjugate_gradient.h): the same inverses as factorize of
+  // its scalar form.
+  template <typename Blocks>
+  BlockJacobiPreconditioner& FactorizeBlocks(const Blocks& blocks) {
+    inverse_.assign(static_cast<std::size_t>(blocks.blocks()), Eigen::Matrix3d::Zero());
+    for (int v = 0; v < blocks.blocks(); ++v) {
+      Eigen::Matrix3d diagonal = Eigen::Matrix3d::Zero();  // column-major, as the block values
+      for (int k = blocks.outer[v]; k < blocks.outer[v + 1]; ++k)
+        if (blocks.row[k] == v)
+          diagonal = Eigen::Map<const Eigen::Matrix3d>(blocks.values.data() + 9 * static_cast<std::size_t>(k));
+      Invert(diagonal, &inverse_[static_cast<std::size_t>(v)]);
+    }
+    return *this;
+  }
+
   template <typename Matrix>
   BlockJacobiPreconditioner& compute(const Matrix& matrix) {
     return factorize(matrix);

@@ -85,14 +85,21 @@ ConjugateGradientResult SolveConjugateGradient(const Eigen::SparseMatrix<double>
                                                int max_iterations, Eigen::VectorXd* x) {
   SUBFLOW_CHECK(A.rows() == A.cols() && A.rows() == b.size() && x->size() == b.size(),
                 "conjugate gradients: sizes differ");
+  return SolveConjugateGradient(MakeBlockSparse(A), b, tolerance, max_iterations, x);
+}
+
+ConjugateGradientResult SolveConjugateGradient(const BlockSparseMatrix& blocks, const Eigen::VectorXd& b,
+                                               double tolerance, int max_iterations, Eigen::VectorXd* x) {
+  SUBFLOW_CHECK(3 * static_cast<Eigen::Index>(blocks.blocks()) == b.size() && x->size() == b.size(),
+                "conjugate gradients: sizes differ");
   ConjugateGradientResult result;
   const double b_norm = b.norm();
   if (b_norm == 0.0) {
     x->setZero();
     return result;
   }
-  const BlockJacobiPreconditioner preconditioner(A);
-  const BlockSparseMatrix blocks = MakeBlockSparse(A);
+  BlockJacobiPreconditioner preconditioner;
+  preconditioner.FactorizeBlocks(blocks);
   Eigen::VectorXd r(b.size()), Ap(b.size());
   MultiplySymmetric(blocks, *x, &Ap);
   r = b - Ap;

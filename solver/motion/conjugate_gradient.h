@@ -42,5 +42,8 @@ struct ConjugateGradientResult {
 ConjugateGradientResult SolveConjugateGradient(const Eigen::SparseMatrix<double>& A,
                                                const Eigen::VectorXd& b, double tolerance,
                                                int max_iterations, Eigen::VectorXd* x);
+// The same for A in block form (the same iterates as its scalar form, to the bit).
+ConjugateGradientResult SolveConjugateGradient(const BlockSparseMatrix& A, const Eigen::VectorXd& b,
+                                               double tolerance, int max_iterations, Eigen::VectorXd* x);
 
 }  // namespace subflow::solver

@@ -124,6 +124,19 @@ LevelMatrix MakeLevelMatrix(const SymmetricPattern& data_pattern, const Sparse& 
       level.data_slot[k] = e < 0 ? -1 : 6 * e + kSym[a][b];
       if (row == column) level.diagonal_slot[row] = level.data_slot[k];
     }
+  level.blocks = MakeBlockSparse(level.regularizer);
+  level.block_slot.resize(level.data_slot.size());
+  for (int j = 0; j < vertices; ++j)
+    for (int b = 0; b < 3; ++b) {
+      const int column = 3 * j + b;
+      int block = level.blocks.outer[j];
+      for (int k = level.regularizer.outerIndexPtr()[column]; k < level.regularizer.outerIndexPtr()[column + 1]; ++k) {
+        const int row = level.regularizer.innerIndexPtr()[k];
+        while (level.blocks.row[block] != row / 3) ++block;
+        level.block_slot[k] = 9 * block + 3 * b + row % 3;
+      }
+    }
+  level.blocks.values = {};  // the structure is what is kept
   return level;
 }
 
@@ -132,6 +145,23 @@ double DataStiffness(const LevelMatrix& level, const std::vector<double>& sums) 
   for (Eigen::Index i = 0; i < diagonal.size(); ++i)
     diagonal(i) = level.diagonal_slot[i] < 0 ? 0.0 : sums[level.diagonal_slot[i]];
   return diagonal.size() > 0 ? diagonal.sum() / diagonal.size() : 0.0;
+}
+
+BlockSparseMatrix AssembleLevelBlocks(const LevelMatrix& level, const std::vector<double>& sums, double stiffness) {
+  BlockSparseMatrix A;
+  A.outer = level.blocks.outer;
+  A.row = level.blocks.row;
+  A.values.assign(9 * level.blocks.row.size(), 0.0);  // entries in neither pattern stay 0
+  const double* regularizer = level.regularizer.valuePtr();
+  const int nonzeros = static_cast<int>(level.regularizer.nonZeros());
+  tbb::parallel_for(tbb::blocked_range<int>(0, nonzeros, 16384), [&](const tbb::blocked_range<int>& range) {
+    for (int k = range.begin(); k < range.end(); ++k) {
+      const int slot = level.data_slot[k];
+      const double value = stiffness * regularizer[k];
+      A.values[level.block_slot[k]] = slot < 0 ? value : sums[slot] + value;
+    }
+  });
+  return A;
 }
 
 Sparse AssembleLevelMatrix(const LevelMatrix& level, const std::vector<double>& sums, double stiffness) {

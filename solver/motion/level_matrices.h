@@ -22,6 +22,7 @@
 #include <Eigen/Sparse>
 
 #include "geometry/loop_operators.h"
+#include "solver/motion/conjugate_gradient.h"
 
 namespace subflow::solver {
 
@@ -55,6 +56,10 @@ struct LevelMatrix {
   Eigen::SparseMatrix<double> regularizer;  // 3#V square: the union pattern, regularizer values
   std::vector<int> data_slot;    // per nonzero: index into the block sums, or −1
   std::vector<int> diagonal_slot;  // per unknown 3v + a: index of its diagonal data value
+  // The same structure in 3×3 blocks (the CG's product; outer and row only, no values),
+  // and per nonzero of `regularizer` the index of its value among the blocks' values.
+  BlockSparseMatrix blocks;
+  std::vector<int> block_slot;
 };
 
 LevelMatrix MakeLevelMatrix(const SymmetricPattern& data_pattern,
@@ -66,5 +71,8 @@ double DataStiffness(const LevelMatrix& level, const std::vector<double>& sums);
 // data + stiffness · regularizer on the level's union pattern, compressed.
 Eigen::SparseMatrix<double> AssembleLevelMatrix(const LevelMatrix& level, const std::vector<double>& sums,
                                                 double stiffness);
+// The same values in the block form (MakeBlockSparse of AssembleLevelMatrix, without the
+// scalar matrix in between).
+BlockSparseMatrix AssembleLevelBlocks(const LevelMatrix& level, const std::vector<double>& sums, double stiffness);
 
 }  // namespace subflow::solver

@@ -359,7 +359,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       const Eigen::VectorXd rhs = ConstVectorMap(data_rhs.data(), unknowns) -
                                   report.smoothness_weight * (smoothness3_[level] * W);
       // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
-      const Sparse A = AssembleLevelMatrix(level_matrix_[level], data[level], report.data_stiffness);
+      const BlockSparseMatrix A = AssembleLevelBlocks(level_matrix_[level], data[level], report.data_stiffness);
       Eigen::VectorXd solution_vector = x;
       const ConjugateGradientResult cg = SolveConjugateGradient(
           A, rhs, cg_tolerance, options_.cg_max_iterations, &solution_vector);

@@ -92,6 +92,21 @@ TEST(LevelMatrices, AssemblyIsDataPlusStiffnessTimesRegularizer) {
   EXPECT_LT((assembled - (data + stiffness * regularizer)).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_GT(level.regularizer.nonZeros(), 9 * levels.fine.entries());  // the union is larger
   EXPECT_NEAR(DataStiffness(level, sums), data.diagonal().mean(), 1e-12);
+
+  // Assembled straight into blocks: the block form of the scalar assembly, to the bit,
+  // and conjugate gradients on it take the same iterates.
+  const BlockSparseMatrix blocks = AssembleLevelBlocks(level, sums, stiffness);
+  const BlockSparseMatrix reference = MakeBlockSparse(AssembleLevelMatrix(level, sums, stiffness));
+  EXPECT_EQ(blocks.outer, reference.outer);
+  EXPECT_EQ(blocks.row, reference.row);
+  EXPECT_EQ(blocks.values, reference.values);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(regularizer.rows(), -1.0, 2.0);
+  Eigen::VectorXd from_blocks = Eigen::VectorXd::Zero(b.size()), from_scalar = from_blocks;
+  const ConjugateGradientResult cg = SolveConjugateGradient(blocks, b, 1e-10, 200, &from_blocks);
+  SolveConjugateGradient(Sparse(AssembleLevelMatrix(level, sums, stiffness)), b, 1e-10, 200, &from_scalar);
+  EXPECT_GT(cg.iterations, 3);
+  EXPECT_EQ(from_blocks, from_scalar);
+  EXPECT_LT((assembled * from_blocks - b).norm(), 1e-8 * b.norm());
 }
 
 }  // namespace
