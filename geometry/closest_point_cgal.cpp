@@ -262,13 +262,16 @@ RayHit ClosestPointTree::NearestHitOnLine(const Eigen::Vector3d& origin,
   const double norm = direction.norm();
   if (!(norm > 0.0) || !origin.allFinite() || !direction.allFinite()) return {};
   const Eigen::Vector3d unit = direction / norm;
-  RayHit forward = impl_->Cast(origin, unit, max_abs_t);
-  RayHit backward = impl_->Cast(origin, -unit, max_abs_t);
-  if (backward.hit) backward.t = -backward.t;
-  RayHit best;
-  if (forward.hit && forward.t <= max_abs_t) best = forward;
-  if (backward.hit && -backward.t <= max_abs_t && (!best.hit || -backward.t < best.t))
+  RayHit best = impl_->Cast(origin, unit, max_abs_t);
+  if (best.hit && best.t > max_abs_t) best = {};
+  if (best.hit && best.t == 0.0) return best;  // no backward hit can be nearer
+  // A backward hit farther than the forward one would lose: search only that far (a short
+  // segment's traversal visits few boxes of the tree).
+  RayHit backward = impl_->Cast(origin, -unit, best.hit ? best.t : max_abs_t);
+  if (backward.hit && backward.t <= max_abs_t && (!best.hit || backward.t < best.t)) {
+    backward.t = -backward.t;
     best = backward;
+  }
   return best;
 }
 
