@@ -41,25 +41,23 @@ Sparse Kron3(const Matrix& A) {
   return result;
 }
 
-// A B for row-major sparse A and B with 3 columns, parallel over A's rows; each row sums its
-// entries in order (the same sums as Eigen's product).
-Positions RowParallelProduct(const geometry::SparseMatrix& A, const Positions& B) {
+// A B for row-major sparse A and row-major B with a fixed number of columns, parallel over
+// A's rows; each row sums its entries in order (the same sums as Eigen's product).
+template <int Columns>
+Eigen::Matrix<double, Eigen::Dynamic, Columns, Eigen::RowMajor> RowParallelProduct(
+    const geometry::SparseMatrix& A, const Eigen::Matrix<double, Eigen::Dynamic, Columns, Eigen::RowMajor>& B) {
   SUBFLOW_CHECK(A.cols() == B.rows(), "product of mismatched sizes");
-  Positions result(A.rows(), 3);
+  Eigen::Matrix<double, Eigen::Dynamic, Columns, Eigen::RowMajor> result(A.rows(), Columns);
   tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(A.rows()), 2048),
                     [&](const tbb::blocked_range<int>& range) {
     for (int r = range.begin(); r < range.end(); ++r) {
-      double x = 0.0, y = 0.0, z = 0.0;
+      double sum[Columns] = {};
       for (int k = A.outerIndexPtr()[r]; k < A.outerIndexPtr()[r + 1]; ++k) {
         const double w = A.valuePtr()[k];
-        const int c = A.innerIndexPtr()[k];
-        x += w * B(c, 0);
-        y += w * B(c, 1);
-        z += w * B(c, 2);
+        const double* b = B.row(A.innerIndexPtr()[k]).data();
+        for (int i = 0; i < Columns; ++i) sum[i] += w * b[i];
       }
-      result(r, 0) = x;
-      result(r, 1) = y;
-      result(r, 2) = z;
+      for (int i = 0; i < Columns; ++i) result(r, i) = sum[i];
     }
   });
   return result;
@@ -239,24 +237,12 @@ NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
 std::vector<double> NormalFlowSolver::DataSums(
     const SampleStencils& stencils, const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& M) {
   // Block (a, b) of N = Σ_s L_sᵀ L_s ⊗ M_s is Σ_s l_sa l_sb M_s: symmetric, and equal to
-  // block (b, a). Only the upper pattern entries (row ≤ column) hold sums, 6 values each,
-  // gathered entry by entry in parallel (each entry's samples added in ascending order:
-  // deterministic, no per-thread copies of the sums to clear and add up).
-  const geometry::SparseMatrix& E = stencils.entry_weights;
-  std::vector<double> sums(6 * static_cast<std::size_t>(E.rows()), 0.0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(E.rows()), 4096),
-                    [&](const tbb::blocked_range<int>& range) {
-    for (int e = range.begin(); e < range.end(); ++e) {
-      double sum[6] = {0, 0, 0, 0, 0, 0};
-      for (int k = E.outerIndexPtr()[e]; k < E.outerIndexPtr()[e + 1]; ++k) {
-        const double w = E.valuePtr()[k];
-        const double* m6 = M.row(E.innerIndexPtr()[k]).data();
-        for (int i = 0; i < 6; ++i) sum[i] += w * m6[i];
-      }
-      std::copy(sum, sum + 6, sums.data() + 6 * static_cast<std::size_t>(e));
-    }
-  });
-  return sums;
+  // block (b, a). Only the upper pattern entries (row ≤ column) hold sums, 6 values each:
+  // the product E M of the entries' weights and the samples' blocks, gathered entry by
+  // entry in parallel (each entry's samples added in ascending order: deterministic, no
+  // per-thread copies of the sums to clear and add up).
+  const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> sums = RowParallelProduct(stencils.entry_weights, M);
+  return std::vector<double>(sums.data(), sums.data() + sums.size());
 }
 
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
