@@ -1,8 +1,11 @@
 #include "vision/evaluation_maps.h"
 
+#include <cmath>
 #include <optional>
 
+#include "core/error.h"
 #include "geometry/closest_point.h"
+#include "geometry/mesh_topology.h"
 #include "geometry/vertex_normals.h"
 #include "vision/evaluation_visibility.h"
 
@@ -12,6 +15,29 @@ namespace {
 double Signed(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& normal) {
   const Eigen::Vector3d d = to - from;
   return d.dot(normal) < 0.0 ? -d.norm() : d.norm();
+}
+
+// Whether `mesh` bounds a volume (closed oriented manifold), so that the inside test of
+// its tree means something.
+bool BoundsAVolume(const geometry::TriangleMesh& mesh) {
+  try {
+    return geometry::MeshTopology(mesh.F, static_cast<int>(mesh.V.rows())).IsClosed();
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+// |distance| signed by the side of `point` with respect to the closed surface of `tree`
+// (`inside_sign` where it is inside); the normal test where the side is undecided (on the
+// surface) or the surface bounds no volume.
+double SignedBySide(const geometry::ClosestPointTree& tree, bool bounds_a_volume, const Eigen::Vector3d& point,
+                    double inside_sign, double normal_signed) {
+  if (bounds_a_volume) {
+    const geometry::PointSide side = tree.Side(point);
+    if (side == geometry::PointSide::kInside) return inside_sign * std::abs(normal_signed);
+    if (side == geometry::PointSide::kOutside) return -inside_sign * std::abs(normal_signed);
+  }
+  return normal_signed;
 }
 
 Eigen::VectorXi Views(const std::optional<SurfaceVisibility>& visibility, const geometry::Positions& points) {
@@ -34,18 +60,26 @@ FrameErrorMaps ComputeErrorMaps(const geometry::TriangleMesh& truth, const geome
   const geometry::Positions face_normals = geometry::FaceNormals(truth.V, truth.F);
   geometry::Positions closest(result.V.rows(), 3);
   maps.result.error.resize(result.V.rows());
+  // The sign is the side of the point with respect to the other closed surface (a truth
+  // point inside the result is covered by it: a lid over a hollow is > 0 on both sides,
+  // whichever way the nearest point lies); the normal test only for open meshes.
+  const bool truth_closed = BoundsAVolume(truth), result_closed = BoundsAVolume(result);
   for (Eigen::Index i = 0; i < result.V.rows(); ++i) {
     closest.row(i) = on_truth[i].point.transpose();
-    maps.result.error[i] = Signed(on_truth[i].point, result.V.row(i).transpose(),
-                                  face_normals.row(on_truth[i].face).transpose());
+    const Eigen::Vector3d x = result.V.row(i).transpose();
+    maps.result.error[i] = SignedBySide(truth_tree, truth_closed, x, -1.0,
+                                        Signed(on_truth[i].point, x, face_normals.row(on_truth[i].face).transpose()));
   }
   maps.result.views = Views(visibility, closest);
 
   const std::vector<geometry::SurfacePoint> on_result = result_tree.ClosestPoints(truth.V);
   const geometry::Positions vertex_normals = geometry::VertexNormals(truth.V, truth.F);
   maps.truth.error.resize(truth.V.rows());
-  for (Eigen::Index i = 0; i < truth.V.rows(); ++i)
-    maps.truth.error[i] = Signed(truth.V.row(i).transpose(), on_result[i].point, vertex_normals.row(i).transpose());
+  for (Eigen::Index i = 0; i < truth.V.rows(); ++i) {
+    const Eigen::Vector3d t = truth.V.row(i).transpose();
+    maps.truth.error[i] = SignedBySide(result_tree, result_closed, t, 1.0,
+                                       Signed(t, on_result[i].point, vertex_normals.row(i).transpose()));
+  }
   maps.truth.views = Views(visibility, truth.V);
   return maps;
 }

@@ -2,14 +2,21 @@
 // --error-maps DIR`): where on the surface the figures of vision/evaluation.h come from.
 //
 // For one frame, with R the result mesh and T the true mesh:
-//   result side, per vertex x of R:  c = the closest point of T, n_T the normal of its face,
-//     error    = sign((x − c)·n_T) |x − c|   (> 0: the result lies outside the truth, a
-//                bulge or a lid over a hollow; < 0: inside, a dent or a plate too thin)
+//   result side, per vertex x of R:  c = the closest point of T,
+//     error    = ±|x − c|, > 0 when x is outside the volume of T: the result lies outside
+//                the truth (a bulge, a lid over a hollow); < 0 inside (a dent, a plate
+//                too thin)
 //     views    = the cameras that see c (vision/evaluation_visibility.h)
-//   truth side, per vertex t of T:   r = the closest point of R, n_t the true vertex normal,
-//     error    = sign((r − t)·n_t) |r − t|   (> 0 where the result passes outside the
-//                truth: a hollow the result does not enter, a plate it keeps fat)
+//   truth side, per vertex t of T:   r = the closest point of R,
+//     error    = ±|r − t|, > 0 when t is inside the volume of R: the result passes outside
+//                the truth there (a hollow it does not enter, a plate it keeps fat)
 //     views    = the cameras that see t.
+// The side is the ray-parity inside test of the other mesh (geometry::ClosestPointTree::
+// Side), not the direction of the nearest point: a vertex deep in a hollow that the result
+// caps has its nearest result point through the hollow's wall, on the far side. Where the
+// other mesh bounds no volume (open, or not a manifold), and for points on it, the sign
+// is that of (x − c)·n_T (n_T the normal of c's face), resp. (r − t)·n_t (the true vertex
+// normal).
 // The truth side shows what the result misses (completeness), the result side where its
 // surface is wrong (accuracy). Views are −1 when no cameras are given.
 #pragma once
