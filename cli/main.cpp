@@ -15,8 +15,9 @@ namespace {
 // (dynamic, at most 32 MB) and a heap top above its trim threshold back to the kernel at
 // once, and the next step faults every page in again: on this paravirtualized machine that
 // was ~10 % of a stage's time in the kernel (docs/speed.md, "Memory given back and faulted
-// in again"). Freed blocks up to 256 MB now stay in the process for the next step; the
-// peak is unchanged, since a block is only kept where a later one of its size reuses it.
+// in again"). Freed blocks up to 256 MB now stay in the process, and the next step's
+// arrays of the same sizes reuse them. Measured peak: blob 0.97 → 0.99 GB, pose2sim
+// 3.80 → 3.69 GB.
 void KeepFreedMemoryForReuse() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
