@@ -2,15 +2,23 @@
 // shape initialization → motion initialization → stereo refinement (unless --no-refine)
 // → re-tracking → rigid / non-rigid split (output/stage_pipeline.h: the stages of the
 // stage commands, each writing its stage folder DIR/stages/<stage>/; --resume reuses the
-// complete ones of an interrupted run).
+// complete ones of an interrupted run). A take longer than --chunk frames runs as the plan
+// of `subflow plan --chunk` (docs/cluster.md) in DIR/plan, its tasks one after another
+// as child processes, so that memory follows the chunk, not the take.
+#include <algorithm>
+#include <filesystem>
 #include <memory>
 
 #include <spdlog/spdlog.h>
 
 #include "cli/commands.h"
+#include "cli/plan_runner.h"
 #include "cli/progress_bar.h"
 #include "cli/stage_options.h"
+#include "core/error.h"
 #include "core/stopwatch.h"
+#include "output/plan.h"
+#include "output/report.h"
 #include "output/result_writer.h"
 #include "output/stage_pipeline.h"
 #include "vision/dataset.h"
@@ -23,8 +31,34 @@ struct ReconstructArguments {
   std::string out;
   bool overwrite = false;
   bool resume = false;
+  int chunk = 100;  // frames per chunk of a longer take (0 = one process whatever the length)
   ReconstructionArguments stages;
 };
+
+// Frames per chunk for a take of `frames` frames at most `chunk` per chunk: the fewest
+// chunks, as even as they can be (101 frames: 51 + 50, not 100 + 1).
+int EvenChunk(int frames, int chunk) {
+  const int chunks = (frames + chunk - 1) / chunk;
+  return std::max(2, (frames + chunks - 1) / chunks);
+}
+
+// The take as plan + run-plan in out/plan, then its result moved into out.
+void RunChunkedReconstruct(const ReconstructArguments& arguments, const vision::Dataset& dataset,
+                           const solver::ReconstructionOptions& options, const output::CommandRun& run, int frames,
+                           const Stopwatch& start) {
+  output::PlanOptions plan_options;
+  plan_options.chunk = EvenChunk(frames, arguments.chunk);
+  const std::string directory = (std::filesystem::path(arguments.out) / "plan").string();
+  std::filesystem::create_directories(directory);
+  spdlog::info("reconstruct: {} frames, more than --chunk {}: run as chunks of {} frames in {} (docs/cluster.md)",
+               frames, arguments.chunk, plan_options.chunk, directory);
+  // Replaces a plan of other options (its tasks whose stamps still hold stay finished):
+  // without --resume, PrepareOutputDirectory removed any plan already.
+  const nlohmann::json plan = output::WritePlan(arguments.dataset, dataset, options, plan_options, directory,
+                                                /*overwrite=*/true, InvocationArguments());
+  const nlohmann::json tasks = RunPlanTasks(directory, plan);
+  output::AdoptPlanResult(plan, tasks, arguments.out, output::ReportHead(run, dataset), start.Seconds());
+}
 
 void RunReconstruct(const ReconstructArguments& arguments) {
   const Stopwatch start;
@@ -34,6 +68,13 @@ void RunReconstruct(const ReconstructArguments& arguments) {
   ProgressBar progress;
   const std::string command = arguments.stages.no_refine ? "reconstruct --no-refine" : "reconstruct";
   const output::CommandRun run{command, arguments.out, arguments.overwrite, arguments.resume, InvocationArguments()};
+  if (arguments.chunk == 1) ThrowError("reconstruct", "--chunk", "expected 0 (one process) or at least 2 frames");
+  const auto [first, end] = output::TakeFrames(arguments.dataset, dataset, options.shape);
+  if (arguments.chunk > 0 && end - first > arguments.chunk) {
+    RunChunkedReconstruct(arguments, dataset, options, run, end - first, start);
+    spdlog::info("reconstruct: written to {} in {:.1f} s", arguments.out, start.Seconds());
+    return;
+  }
   const nlohmann::json stages = output::RunReconstruction(run, dataset, options, arguments.resume, &progress, start);
   spdlog::info("reconstruct: written to {} in {:.1f} s (stages: {})", arguments.out, start.Seconds(), stages.dump());
 }
@@ -49,6 +90,10 @@ Command AddReconstructCommand(CLI::App& app) {
   sub->add_flag("--resume", arguments->resume,
                 "Continue an interrupted run in --out: complete stage folders (OUT/stages/) written with the "
                 "same options are loaded instead of recomputed");
+  sub->add_option("--chunk", arguments->chunk,
+                  "A take of more frames runs as chunks of at most this many (subflow plan + run-plan in OUT/plan), "
+                  "so memory follows the chunk, not the take; 0 = one process whatever the length")
+      ->capture_default_str()->check(CLI::Range(0, 1 << 30));
   AddReconstructionOptions(sub, &arguments->stages);
   return {sub, [arguments] { RunReconstruct(*arguments); }};
 }

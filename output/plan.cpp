@@ -111,6 +111,14 @@ class PlanBuilder {
 
 }  // namespace
 
+std::pair<int, int> TakeFrames(const std::string& dataset_path, const vision::Dataset& dataset,
+                               const solver::ShapeInitOptions& options) {
+  const int available = dataset.frame_count() - options.first_frame;
+  if (available <= 0) ThrowError(dataset_path, "first_frame", "past the last frame");
+  return {options.first_frame,
+          options.first_frame + (options.frame_count < 0 ? available : std::min(options.frame_count, available))};
+}
+
 nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dataset& dataset,
                          const solver::ReconstructionOptions& options, const PlanOptions& plan_options,
                          const std::string& directory_name, bool overwrite, const nlohmann::json& arguments) {
@@ -119,10 +127,8 @@ nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dat
   const std::string directory = fs::absolute(directory_name).lexically_normal().string();
   const std::string dataset_path = fs::absolute(dataset_directory).lexically_normal().string();
   const solver::ShapeInitOptions& shape = options.shape;
-  const int available = dataset.frame_count() - shape.first_frame;
-  if (available <= 0) ThrowError(dataset_path, "first_frame", "past the last frame");
-  const Range take{shape.first_frame,
-                   shape.first_frame + (shape.frame_count < 0 ? available : std::min(shape.frame_count, available))};
+  const auto [take_first, take_end] = TakeFrames(dataset_path, dataset, shape);
+  const Range take{take_first, take_end};
   const int reference = shape.reference_frame < 0 ? take.first + (take.end - take.first) / 2 : shape.reference_frame;
   std::vector<Range> chunks;
   for (int first = take.first; first < take.end; first += plan_options.chunk)
@@ -192,6 +198,57 @@ nlohmann::json ReadPlan(const std::string& directory) {
       if (!reader.Required(tasks[i], key, where).is_array()) reader.Fail(where + "." + key, "expected an array");
   }
   return plan;
+}
+
+namespace {
+
+// The report.json key of a plan task's stage in "timings_seconds".
+std::string TimingKey(const std::string& stage) {
+  if (stage == "shape") return "shape_init";
+  if (stage == "motion") return "motion_init";
+  if (stage == "refine") return "refinement";
+  return stage;  // retrack, split
+}
+
+}  // namespace
+
+void AdoptPlanResult(const nlohmann::json& plan, const nlohmann::json& tasks, const std::string& out,
+                     nlohmann::json head, double total_seconds) {
+  const fs::path result = plan.at("result").get<std::string>();
+  const fs::path result_report = result / "report.json";
+  nlohmann::json report = ReadJsonFile(result_report.string(), "the report of the plan's split task");
+  std::error_code error;
+  for (const char* entry : kResultEntries) {
+    const std::string name = entry;
+    if (name == "report.json" || name == "stages" || name == "plan" || !fs::exists(result / name)) continue;
+    fs::remove_all(fs::path(out) / name, error);
+    if (!error) fs::rename(result / name, fs::path(out) / name, error);
+    if (error) ThrowError((fs::path(out) / name).string(), "", "cannot move the plan's result here: " + error.message());
+  }
+  // Its files are gone: the split task is no longer finished (a --resume runs it again).
+  fs::remove_all(result, error);
+
+  nlohmann::json timings = nlohmann::json::object();
+  const fs::path status = fs::path(plan.at("directory").get<std::string>()) / "status";
+  for (const nlohmann::json& task : tasks) {
+    double seconds = task.value("seconds", 0.0);
+    if (task.value("skipped", false)) {
+      const fs::path file = status / (task.at("id").get<std::string>() + ".json");
+      if (fs::is_regular_file(file)) seconds = ReadJsonFile(file.string(), "a task's status").value("seconds", 0.0);
+    }
+    const std::string key = TimingKey(task.value("stage", ""));
+    timings[key] = timings.value(key, 0.0) + seconds;
+  }
+  timings["total"] = total_seconds;
+  report.update(head);
+  report["timings_seconds"] = timings;
+  report["total_seconds"] = total_seconds;
+  report["plan"] = {{"directory", plan.at("directory")},
+                    {"chunk", plan.at("chunk")},
+                    {"overlap", plan.at("overlap")},
+                    {"chunks", plan.at("chunks")},
+                    {"tasks", tasks}};
+  WriteJsonFile((fs::path(out) / "report.json").string(), report);
 }
 
 }  // namespace subflow::output

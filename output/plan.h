@@ -22,6 +22,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -60,6 +61,21 @@ nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dat
                          const solver::ReconstructionOptions& options, const PlanOptions& plan_options,
                          const std::string& directory, bool overwrite,
                          const nlohmann::json& arguments = nlohmann::json::object());
+
+// The dataset frames [first, end) that `options` reconstruct (shape.first_frame,
+// shape.frame_count; −1 = to the end); throws subflow::Error naming the dataset when none.
+std::pair<int, int> TakeFrames(const std::string& dataset_path, const vision::Dataset& dataset,
+                               const solver::ShapeInitOptions& options);
+
+// `subflow reconstruct` of a take longer than its --chunk, after run-plan's tasks of the
+// plan `plan` (in out/plan) finished: moves the result (PLAN/result, OUTPUT.md) into `out`
+// and writes out/report.json: the split task's report with `head` (ReportHead: command,
+// arguments, output, ...) over it, "plan" (chunk, overlap, chunks, `tasks`: what
+// RunPlanTasks returned) and "timings_seconds" per stage summed over the tasks (a skipped
+// task: the seconds its status file recorded) with "total" = `total_seconds`. report.json
+// is written last.
+void AdoptPlanResult(const nlohmann::json& plan, const nlohmann::json& tasks, const std::string& out,
+                     nlohmann::json head, double total_seconds);
 
 // Reads directory/plan.json; throws subflow::Error naming it.
 nlohmann::json ReadPlan(const std::string& directory);

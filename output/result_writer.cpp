@@ -23,7 +23,7 @@ void PrepareOutputDirectory(const std::string& directory, bool overwrite, bool r
     // (a frame beyond the new run's last) passes for part of the new result. Other files
     // of the directory are the user's and stay.
     for (const char* entry : kResultEntries) {
-      if (resume && std::string(entry) == "stages") continue;
+      if (resume && (std::string(entry) == "stages" || std::string(entry) == "plan")) continue;
       fs::remove_all(fs::path(directory) / entry, error);
       if (error) ThrowError((fs::path(directory) / entry).string(), "", "cannot remove: " + error.message());
     }

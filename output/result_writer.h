@@ -20,15 +20,16 @@ namespace subflow::output {
 
 // What a result directory holds (this layout and output/result_files.h): the entries
 // --overwrite replaces.
-// "stages" holds reconstruct's stage folders (docs/stages.md).
+// "stages" holds reconstruct's stage folders (docs/stages.md), "plan" the plan a take
+// longer than reconstruct's --chunk runs as (docs/cluster.md).
 inline constexpr const char* kResultEntries[] = {"meshes", "report.json", "hull", "base_mesh.ply",
-                                                 "control", "obj", "stages"};
+                                                 "control", "obj", "stages", "plan"};
 
 // Creates `directory` (and its parents). Throws subflow::Error naming it when it exists
 // and is not empty and neither `overwrite` nor `resume` is set, or when it cannot be
 // created. With `overwrite`, removes the kResultEntries it holds (other files stay); with
-// `resume` (reconstruct --resume), the same but for "stages", whose complete stage
-// folders the run reuses.
+// `resume` (reconstruct --resume), the same but for "stages" and "plan", whose complete
+// stage folders and finished tasks the run reuses.
 void PrepareOutputDirectory(const std::string& directory, bool overwrite, bool resume = false);
 
 // Writes <directory>/meshes/<frame>.ply for frames first_frame + i, i = 0..#positions − 1.
