@@ -67,7 +67,8 @@ int RunChild(const std::vector<std::string>& argv, long* max_rss_kib) {
 }
 
 // Runs task `task` of the plan in `directory` unless finished; records its status.
-nlohmann::json RunTask(const std::string& directory, const nlohmann::json& plan, const nlohmann::json& task) {
+nlohmann::json RunTask(const std::string& directory, const nlohmann::json& plan, const nlohmann::json& task,
+                       const std::string& position) {
   const std::string id = task.at("id").get<std::string>();
   nlohmann::json record = {{"id", id}, {"stage", task.value("stage", "")}, {"frames", task.value("frames", nlohmann::json())}};
   if (output::TaskFinished(task)) {
@@ -80,7 +81,8 @@ nlohmann::json RunTask(const std::string& directory, const nlohmann::json& plan,
       if (other.at("id") == dependency && !output::TaskFinished(other))
         ThrowError((fs::path(directory) / "plan.json").string(), "task " + id,
                    "depends on " + dependency.get<std::string>() + ", which has not finished");
-  spdlog::info("run-plan: {} ({} frames {})", id, task.value("stage", ""), task.value("frames", nlohmann::json()).dump());
+  spdlog::info("run-plan: {} ({} frames {}, {})", id, task.value("stage", ""),
+               task.value("frames", nlohmann::json()).dump(), position);
   LogStageBegin("task " + id, 0);
   const Stopwatch start;
   long max_rss_kib = 0;
@@ -111,9 +113,11 @@ nlohmann::json RunTask(const std::string& directory, const nlohmann::json& plan,
 
 nlohmann::json RunPlanTasks(const std::string& directory, const nlohmann::json& plan, const std::string& only) {
   nlohmann::json records = nlohmann::json::array();
-  for (const nlohmann::json& task : plan.at("tasks")) {
+  const std::size_t total = plan.at("tasks").size();
+  for (std::size_t i = 0; i < total; ++i) {
+    const nlohmann::json& task = plan.at("tasks")[i];
     if (!only.empty() && task.at("id") != only) continue;
-    records.push_back(RunTask(directory, plan, task));
+    records.push_back(RunTask(directory, plan, task, "task " + std::to_string(i + 1) + " of " + std::to_string(total)));
   }
   if (records.empty()) ThrowError((fs::path(directory) / "plan.json").string(), "task", "no task \"" + only + "\"");
   return records;
