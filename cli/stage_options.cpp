@@ -168,6 +168,8 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
                   "Weight of the temporal self-correlation (motion along the surface)")->capture_default_str();
   sub->add_option("--silhouette-weight", o->silhouette_weight, "Weight of the outline term per pixel")
       ->capture_default_str();
+  sub->add_option("--silhouette-from-level", o->silhouette_from_level,
+                  "Coarsest level with outline blocks (a base-level block drags a wide region)")->capture_default_str();
   sub->add_option("--membrane-weight", o->membrane_weight, "Spatial smoothness of the corrections")
       ->capture_default_str();
   sub->add_option("--temporal-smoothness", o->temporal_smoothness,

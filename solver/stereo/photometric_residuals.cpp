@@ -182,7 +182,7 @@ int AddTemporalResiduals(RefinementWindow& window, int frame, int face, const Pa
 void AddSilhouetteResiduals(RefinementWindow& window, int frame, int face, ceres::Problem* problem,
                             std::vector<ResidualRecord>* records) {
   const StereoRefinementOptions& options = *window.options;
-  if (options.silhouette_weight <= 0) return;
+  if (options.silhouette_weight <= 0 || window.level < options.silhouette_from_level) return;
   const std::vector<vision::Camera>& cameras = *window.cameras;
   const auto& distances = window.images->Silhouettes(frame);
   const std::vector<int>& support = window.sampling->support[face];

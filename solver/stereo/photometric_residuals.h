@@ -9,7 +9,8 @@
 //              window's first frame: for each of those cameras, the patch at t against the
 //              same patch at the other frame (eq. 25's second sum, Δt = 1), weight
 //              temporal_weight · cos^{2p} θ — what refines the motion along the surface;
-//   silhouette one block per patch, frame and camera with a silhouette in which the
+//   silhouette from level silhouette_from_level on (0, every level, by default),
+//              one block per patch, frame and camera with a silhouette in which the
 //              patch's middle sample lies outside, on or within half a pixel of the
 //              outline: w · max(0, D(p(X))), D the signed distance (one-sided: no point is
 //              pushed outside the outline, and a sample near but not on the contour

@@ -214,6 +214,7 @@ void StereoRefinementOptions::Check() const {
   require(temporal_weight >= 0 && silhouette_weight >= 0 && membrane_weight >= 0 &&
               temporal_smoothness >= 0 && damping >= 0,
           "weights", "must be ≥ 0");
+  require(silhouette_from_level >= 0, "silhouette_from_level", "must be ≥ 0");
   require(min_patch_area > 0, "min_patch_area", "must be > 0 (pixels²)");
   require(detail_threshold >= 0, "detail_threshold", "must be ≥ 0 (edge lengths; 0 = off)");
   require(min_detail_patch_area > 0, "min_detail_patch_area", "must be > 0 (pixels²)");

@@ -156,6 +156,14 @@ struct StereoRefinementOptions {
   double ncc_loss_scale = 0.5;     // Cauchy scale on ‖r‖² = 2 − 2 NCC; 0 = plain squares
   double temporal_weight = 1.0;    // self-correlation blocks, relative to stereo
   double silhouette_weight = 0.05; // per pixel of outline distance
+  // Coarsest level with outline blocks. One block acts at a patch's middle sample and moves
+  // all of the patch's support, which on the base level is a large part of the subject.
+  // Starting at level 1 was measured on every scene (docs/shape.md, "The outline term on the
+  // base level"): with exact masks it helps (observed accuracy P90 blob 0.422 → 0.291 mm,
+  // bust_front 0.746 → 0.610 px, critter_ring 1.260 → 1.021 px) or costs (pair_dome 0.948 →
+  // 0.984, mug_ring 4.131 → 4.579); without masks it costs critter_nomasks 1.167 → 1.819 px.
+  // Not one way better: the base level keeps its outline blocks.
+  int silhouette_from_level = 0;
   // Pair weight W(i, j) = (cos θ_i cos θ_j)^p: grazing views see the texture foreshortened
   // and blurred along the surface, which biases the correlation optimum.
   double angle_weight_power = 3.0;

@@ -54,6 +54,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
   return {
       {"--overwrite", {"", "/overwrite", true}},
       {"--resume", {"", "/resume", true}},
+      {"--chunk", {"50", "/arguments/--chunk", "50"}},  // longer than the take: one process
       {"--no-refine", {"", "/options/refine", false}},
       {"--no-retrack", {"", "/options/retrack", false}},
       {"--retrack-weight", {"0.3", "/options/retrack_weight", 0.3}},
@@ -95,6 +96,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--max-cameras", {"4", "/options/refinement/max_cameras", 4}},
       {"--temporal-weight", {"0.5", "/options/refinement/temporal_weight", 0.5}},
       {"--silhouette-weight", {"0.1", "/options/refinement/silhouette_weight", 0.1}},
+      {"--silhouette-from-level", {"2", "/options/refinement/silhouette_from_level", 2}},
       {"--membrane-weight", {"0.2", "/options/refinement/membrane_weight", 0.2}},
       {"--temporal-smoothness", {"0.2", "/options/refinement/temporal_smoothness", 0.2}},
   };

@@ -125,11 +125,13 @@ TEST(TemporalResiduals, VanishOnAStaticSceneWithStepsForwardAndBackAtTheWindowSt
     EXPECT_EQ(AddTemporalResiduals(without.window, 1, f, CamerasOfPatch(without.window, 1, f), nullptr, &empty), 0);
 }
 
-int SilhouetteBlocks(const std::vector<cv::Mat>& masks, double* mean_residual) {
-  OpenedWindow opened(Scene(), Scene().scene.control, 1, 0, 0, 0, {}, &masks);
+// The silhouette blocks of a window on level `level` with `options` and their mean residual.
+int SilhouetteBlocks(const std::vector<cv::Mat>& masks, double* mean_residual, int level = 0,
+                     const StereoRefinementOptions& options = {}) {
+  OpenedWindow opened(Scene(), Scene().scene.control, 1, level, 0, 0, options, &masks);
   ceres::Problem problem(NoLossOwnership());
   std::vector<ResidualRecord> records;
-  for (int f = 0; f < Scene().scene.hierarchy.FaceCount(0); ++f)
+  for (int f = 0; f < Scene().scene.hierarchy.FaceCount(level); ++f)
     AddSilhouetteResiduals(opened.window, 0, f, &problem, &records);
   double sum = 0.0;
   for (const ResidualRecord& record : records) {
@@ -141,6 +143,30 @@ int SilhouetteBlocks(const std::vector<cv::Mat>& masks, double* mean_residual) {
   }
   *mean_residual = records.empty() ? 0.0 : sum / records.size();
   return static_cast<int>(records.size());
+}
+
+// Masks shrunk by 8 px around each camera's silhouette.
+std::vector<cv::Mat> ShrunkMasks() {
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(17, 17));
+  std::vector<cv::Mat> shrunk;
+  for (const cv::Mat& mask : Scene().masks) {
+    shrunk.emplace_back();
+    cv::erode(mask, shrunk.back(), kernel);
+  }
+  return shrunk;
+}
+
+// The outline blocks start at silhouette_from_level (0 by default): with 1, none on the
+// base level and blocks again on level 1.
+TEST(SilhouetteResiduals, StartAtTheirCoarsestLevel) {
+  const std::vector<cv::Mat> shrunk = ShrunkMasks();
+  double mean = 0;
+  StereoRefinementOptions from_level_1;
+  from_level_1.silhouette_from_level = 1;
+  EXPECT_EQ(StereoRefinementOptions().silhouette_from_level, 0);
+  EXPECT_GT(SilhouetteBlocks(shrunk, &mean, 0, StereoRefinementOptions()), 0);
+  EXPECT_EQ(SilhouetteBlocks(shrunk, &mean, 0, from_level_1), 0);
+  EXPECT_GT(SilhouetteBlocks(shrunk, &mean, 1, from_level_1), 0);
 }
 
 // One-sided: masks grown by 8 px leave every patch inside (no block); the exact masks
