@@ -17,6 +17,7 @@
 
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "core/json_reader.h"
 #include "core/stopwatch.h"
 #include "output/plan.h"
 #include "output/result_writer.h"
@@ -36,9 +37,22 @@ int RunChild(const std::vector<std::string>& argv, long* max_rss_kib) {
   for (const std::string& argument : argv) pointers.push_back(const_cast<char*>(argument.c_str()));
   pointers.push_back(nullptr);
   const pid_t parent = getpid();
+  // SIGINT and SIGTERM blocked from before the fork until the task has its own handlers
+  // (core/interrupt.h unblocks them): one arriving in between stays pending for the task,
+  // instead of being recorded by this process's handler in the child and lost at exec.
+  sigset_t stops, before;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  sigprocmask(SIG_BLOCK, &stops, &before);
   const pid_t child = fork();
-  if (child < 0) ThrowError("run-plan", "", std::string("fork failed: ") + std::strerror(errno));
+  if (child < 0) {
+    sigprocmask(SIG_SETMASK, &before, nullptr);
+    ThrowError("run-plan", "", std::string("fork failed: ") + std::strerror(errno));
+  }
   if (child == 0) {
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
     // Its own process group, so that a Ctrl-C at the terminal reaches the task once, from
     // here (a second SIGINT would kill it before it stops cleanly); and it stops when this
     // process dies without passing anything on.
@@ -48,6 +62,7 @@ int RunChild(const std::vector<std::string>& argv, long* max_rss_kib) {
     execv(binary.c_str(), pointers.data());
     _exit(127);
   }
+  sigprocmask(SIG_SETMASK, &before, nullptr);
   int status = 0;
   struct rusage usage {};
   bool passed_on = false;
@@ -71,11 +86,18 @@ nlohmann::json RunTask(const std::string& directory, const nlohmann::json& plan,
                        const std::string& position) {
   const std::string id = task.at("id").get<std::string>();
   nlohmann::json record = {{"id", id}, {"stage", task.value("stage", "")}, {"frames", task.value("frames", nlohmann::json())}};
+  const fs::path status = fs::path(directory) / "status" / (id + ".json");
   if (output::TaskFinished(task)) {
     spdlog::info("run-plan: {} finished already (skipped)", id);
     record["skipped"] = true;
+    if (fs::is_regular_file(status)) {  // what its run recorded
+      const nlohmann::json recorded = ReadJsonFile(status.string(), "a task's status (run-plan)");
+      record["seconds"] = recorded.value("seconds", 0.0);
+      record["max_rss_kib"] = recorded.value("max_rss_kib", 0);
+    }
     return record;
   }
+  ThrowIfInterrupted();
   for (const auto& dependency : task.at("depends_on"))
     for (const nlohmann::json& other : plan.at("tasks"))
       if (other.at("id") == dependency && !output::TaskFinished(other))
@@ -91,17 +113,17 @@ nlohmann::json RunTask(const std::string& directory, const nlohmann::json& plan,
   const int exit_code = RunChild(task.at("argv").get<std::vector<std::string>>(), &max_rss_kib);
   const double seconds = start.Seconds();
   fs::create_directories(fs::path(directory) / "status");
-  output::WriteJsonFile((fs::path(directory) / "status" / (id + ".json")).string(),
+  output::WriteJsonFile(status.string(),
                         {{"id", id},
                          {"stamp", task.at("stamp")},
                          {"exit_code", exit_code},
                          {"seconds", seconds},
                          {"max_rss_kib", max_rss_kib}});
+  if (exit_code == 0) output::RecordTaskFinished(task);  // even when a stop came as it ended
   ThrowIfInterrupted();
   if (exit_code != 0)
     ThrowError((fs::path(directory) / "plan.json").string(), "task " + id,
                "failed (exit code " + std::to_string(exit_code) + "); run-plan again re-runs it and what follows");
-  output::RecordTaskFinished(task);
   LogStageEnd();
   record["skipped"] = false;
   record["seconds"] = seconds;

@@ -5,7 +5,6 @@
 // complete ones of an interrupted run). A take longer than --chunk frames runs as the plan
 // of `subflow plan --chunk` (docs/cluster.md) in DIR/plan, its tasks one after another
 // as child processes, so that memory follows the chunk, not the take.
-#include <algorithm>
 #include <filesystem>
 #include <memory>
 
@@ -35,23 +34,16 @@ struct ReconstructArguments {
   ReconstructionArguments stages;
 };
 
-// Frames per chunk for a take of `frames` frames at most `chunk` per chunk: the fewest
-// chunks, as even as they can be (101 frames: 51 + 50, not 100 + 1).
-int EvenChunk(int frames, int chunk) {
-  const int chunks = (frames + chunk - 1) / chunk;
-  return std::max(2, (frames + chunks - 1) / chunks);
-}
-
 // The take as plan + run-plan in out/plan, then its result moved into out.
 void RunChunkedReconstruct(const ReconstructArguments& arguments, const vision::Dataset& dataset,
                            const solver::ReconstructionOptions& options, const output::CommandRun& run, int frames,
                            const Stopwatch& start) {
   output::PlanOptions plan_options;
-  plan_options.chunk = EvenChunk(frames, arguments.chunk);
+  plan_options.chunk = arguments.chunk;
   const std::string directory = (std::filesystem::path(arguments.out) / "plan").string();
   std::filesystem::create_directories(directory);
-  spdlog::info("reconstruct: {} frames, more than --chunk {}: run as chunks of {} frames in {} (docs/cluster.md)",
-               frames, arguments.chunk, plan_options.chunk, directory);
+  spdlog::info("reconstruct: {} frames, more than --chunk {}: run as a plan of chunks in {} (docs/cluster.md)",
+               frames, arguments.chunk, directory);
   // Replaces a plan of other options (its tasks whose stamps still hold stay finished):
   // without --resume, PrepareOutputDirectory removed any plan already.
   const nlohmann::json plan = output::WritePlan(arguments.dataset, dataset, options, plan_options, directory,
@@ -63,12 +55,12 @@ void RunChunkedReconstruct(const ReconstructArguments& arguments, const vision::
 void RunReconstruct(const ReconstructArguments& arguments) {
   const Stopwatch start;
   const solver::ReconstructionOptions options = arguments.stages.Options();
+  if (arguments.chunk == 1) ThrowError("reconstruct", "--chunk", "expected 0 (one process) or at least 2 frames");
   const vision::Dataset dataset(arguments.dataset);
   output::PrepareOutputDirectory(arguments.out, arguments.overwrite, arguments.resume);
   ProgressBar progress;
   const std::string command = arguments.stages.no_refine ? "reconstruct --no-refine" : "reconstruct";
   const output::CommandRun run{command, arguments.out, arguments.overwrite, arguments.resume, InvocationArguments()};
-  if (arguments.chunk == 1) ThrowError("reconstruct", "--chunk", "expected 0 (one process) or at least 2 frames");
   const auto [first, end] = output::TakeFrames(arguments.dataset, dataset, options.shape);
   if (arguments.chunk > 0 && end - first > arguments.chunk) {
     RunChunkedReconstruct(arguments, dataset, options, run, end - first, start);

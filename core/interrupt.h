@@ -63,6 +63,13 @@ inline void InstallInterruptHandlers() {
   action.sa_flags = SA_RESETHAND | SA_RESTART;  // a second signal gets the default action
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  // A task started by run-plan or a chunked reconstruct (cli/plan_runner.cpp) starts with
+  // both blocked, so that a stop arriving before its handlers exist stays pending: now.
+  sigset_t stops;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  sigprocmask(SIG_UNBLOCK, &stops, nullptr);
 }
 
 // The signal that requested a stop, 0 when none did.

@@ -130,11 +130,17 @@ nlohmann::json WritePlan(const std::string& dataset_directory, const vision::Dat
   const auto [take_first, take_end] = TakeFrames(dataset_path, dataset, shape);
   const Range take{take_first, take_end};
   const int reference = shape.reference_frame < 0 ? take.first + (take.end - take.first) / 2 : shape.reference_frame;
+  // The fewest chunks of at most `chunk` frames, their sizes differing by at most one
+  // (101 frames at 100: 51 + 50, not 100 + 1).
+  const int frames = take.end - take.first;
+  const int count = (frames + plan_options.chunk - 1) / plan_options.chunk;
   std::vector<Range> chunks;
-  for (int first = take.first; first < take.end; first += plan_options.chunk)
-    chunks.push_back({first, std::min(first + plan_options.chunk, take.end)});
-  const int reference_chunk = std::clamp((reference - take.first) / plan_options.chunk, 0,
-                                         static_cast<int>(chunks.size()) - 1);
+  int reference_chunk = 0;
+  for (int c = 0; c < count; ++c) {
+    chunks.push_back({take.first + static_cast<int>(static_cast<long long>(c) * frames / count),
+                      take.first + static_cast<int>(static_cast<long long>(c + 1) * frames / count)});
+    if (reference >= chunks.back().first && reference < chunks.back().end) reference_chunk = c;
+  }
 
   PlanBuilder plan(dataset_path, directory, options);
   plan.Add("shape", "shape", take,
@@ -217,7 +223,13 @@ void AdoptPlanResult(const nlohmann::json& plan, const nlohmann::json& tasks, co
   const fs::path result = plan.at("result").get<std::string>();
   const fs::path result_report = result / "report.json";
   nlohmann::json report = ReadJsonFile(result_report.string(), "the report of the plan's split task");
+  // The split task is no longer finished before anything leaves its folder: a run stopped
+  // while moving makes --resume run it again, not skip it with half its files gone.
   std::error_code error;
+  for (const fs::path& file : {result_report, result / kTaskStampFile}) {
+    fs::remove(file, error);
+    if (error) ThrowError(file.string(), "", "cannot remove: " + error.message());
+  }
   for (const char* entry : kResultEntries) {
     const std::string name = entry;
     if (name == "report.json" || name == "stages" || name == "plan" || !fs::exists(result / name)) continue;
@@ -225,19 +237,13 @@ void AdoptPlanResult(const nlohmann::json& plan, const nlohmann::json& tasks, co
     if (!error) fs::rename(result / name, fs::path(out) / name, error);
     if (error) ThrowError((fs::path(out) / name).string(), "", "cannot move the plan's result here: " + error.message());
   }
-  // Its files are gone: the split task is no longer finished (a --resume runs it again).
   fs::remove_all(result, error);
+  if (error) ThrowError(result.string(), "", "cannot remove the plan's emptied result folder: " + error.message());
 
   nlohmann::json timings = nlohmann::json::object();
-  const fs::path status = fs::path(plan.at("directory").get<std::string>()) / "status";
   for (const nlohmann::json& task : tasks) {
-    double seconds = task.value("seconds", 0.0);
-    if (task.value("skipped", false)) {
-      const fs::path file = status / (task.at("id").get<std::string>() + ".json");
-      if (fs::is_regular_file(file)) seconds = ReadJsonFile(file.string(), "a task's status").value("seconds", 0.0);
-    }
     const std::string key = TimingKey(task.value("stage", ""));
-    timings[key] = timings.value(key, 0.0) + seconds;
+    timings[key] = timings.value(key, 0.0) + task.value("seconds", 0.0);
   }
   timings["total"] = total_seconds;
   report.update(head);

