@@ -150,7 +150,8 @@ TEST(ChunkedReconstruct, AStopReachesTheRunningTaskAndResumeFinishesTheRest) {
   const test::KilledRun resumed = test::RunAndKill(resume, "never printed", 1, SIGINT);
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   ExpectTheSameResult(out, PlanResult());
-  for (const auto& task : ReadJson(out / "report.json")["plan"]["tasks"]) {
+  const nlohmann::json report = ReadJson(out / "report.json");
+  for (const auto& task : report["plan"]["tasks"]) {
     const bool before_the_stop = task["id"] == "shape" || task["stage"] == "motion";  // motion chunks and merge
     EXPECT_EQ(task["skipped"].get<bool>(), before_the_stop) << task;
     EXPECT_GT(task["seconds"].get<double>(), 0.0) << task;  // a skipped task: its earlier run's
