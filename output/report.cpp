@@ -190,6 +190,10 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
                       {"correction_rms_before", f.correction_rms_before},
                       {"correction_rms_applied", f.correction_rms_applied},
                       {"seconds", f.step.seconds}});
+    if (o.guess_from_targets && f.from_frame >= 0)
+      frames.back()["guess"] = {{"used", f.step.guess_used},
+                                {"photometric_rms", f.step.guess_rms},
+                                {"photometric_rms_zero_motion", f.step.guess_rms_zero}};
   }
   return {{"options", o},
           {"reference_frame", first_frame + result.reference_frame},

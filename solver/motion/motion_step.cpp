@@ -90,6 +90,16 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
   for (int pass = 0; pass < passes; ++pass) {
     smoothed_before = SmoothAll(before, options_.image_sigmas[pass]);
     smoothed_after = SmoothAll(after, options_.image_sigmas[pass]);
+    if (pass == 0 && guess) {
+      // The guess is a start, not a given: where it matches the images worse than no motion
+      // does (trajectories that jump from frame to frame), the step starts from zero.
+      step.report.guess_rms = Rms(StepPhotometricDifferences(cameras_, smoothed_before, smoothed_after, positions,
+                                                             sample_motion, visibility));
+      step.report.guess_rms_zero = Rms(StepPhotometricDifferences(cameras_, smoothed_before, smoothed_after,
+                                                                  positions, Positions(), visibility));
+      step.report.guess_used = step.report.guess_rms < step.report.guess_rms_zero;
+      if (!step.report.guess_used) sample_motion = Positions();
+    }
     const NormalFlowConstraints constraints = BuildStepConstraints(
         cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility);
     if (pass == passes - 1) {

@@ -53,6 +53,11 @@ struct MotionStepReport {
   double photometric_rms_zero = 0.0;
   double photometric_rms = 0.0;
   double mean_displacement = 0.0;  // mean |∂c| over the finest control points
+  // With a guess: the RMS as above at the first pass's σ for the guess and for zero motion;
+  // the guess is used only when it is the better start.
+  double guess_rms = 0.0;
+  double guess_rms_zero = 0.0;
+  bool guess_used = false;
   int cg_iterations = 0;           // over all passes
   double seconds = 0.0;
 };
@@ -75,7 +80,8 @@ class MotionStepEstimator {
   // Displacement of `control` (finest control points at the `before` frame) between the
   // two sets of images (one per camera). `guess` (optional, #V(n)×3): a displacement the
   // first pass linearizes at instead of zero (e.g. the step of trajectories known to be
-  // close), so that fewer passes from coarse σ are needed.
+  // close), so that fewer passes from coarse σ are needed; ignored when it matches the
+  // images worse than zero motion (report.guess_used).
   MotionStep Estimate(const geometry::Positions& control, const std::vector<cv::Mat>& before,
                       const std::vector<cv::Mat>& after, const geometry::Positions* guess = nullptr) const;
 
