@@ -95,13 +95,13 @@ inline CommandResult RunSubflow(const std::string& arguments,
   return run;
 }
 
-// The small deforming blob the reconstruct tests run on (6 gray cameras, 3 frames,
+// The small deforming blob the reconstruct tests run on (6 gray cameras, `frames` frames,
 // 160×120), written by `subflow synth` to <scratch>/blob.
-inline std::filesystem::path SynthSmallBlob(const TemporaryDirectory& scratch) {
+inline std::filesystem::path SynthSmallBlob(const TemporaryDirectory& scratch, int frames = 3) {
   const std::filesystem::path path = scratch / "blob";
-  const CommandResult run = RunSubflow(
-      "synth blob --out '" + path.string() + "' --cameras 6 --frames 3 --width 160 --height 120 --subdivisions 4 --gray",
-      scratch.path());
+  const CommandResult run = RunSubflow("synth blob --out '" + path.string() + "' --cameras 6 --frames " +
+                                           std::to_string(frames) + " --width 160 --height 120 --subdivisions 4 --gray",
+                                       scratch.path());
   if (run.exit_code != 0) throw std::runtime_error("subflow synth failed: " + run.output());
   return path;
 }

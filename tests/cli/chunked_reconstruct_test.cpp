@@ -33,14 +33,7 @@ const std::vector<std::string> kSmall = {"--base-faces", "120", "--levels", "2",
 
 // A small deforming blob: 6 gray cameras, 8 frames, 160×120.
 const fs::path& Dataset() {
-  static const fs::path dataset = [] {
-    const fs::path path = Scratch() / "blob";
-    const test::CommandResult run = test::RunSubflow(
-        "synth blob --out " + Quoted(path) + " --cameras 6 --frames 8 --width 160 --height 120 --subdivisions 4 --gray",
-        Scratch().path());
-    EXPECT_EQ(run.exit_code, 0) << run.output();
-    return path;
-  }();
+  static const fs::path dataset = test::SynthSmallBlob(Scratch(), 8);
   return dataset;
 }
 
