@@ -54,6 +54,32 @@ double SampleMotionError(const MotionStepEstimator& estimator, const Positions& 
   return error / magnitude;
 }
 
+// One translation `t` of the scene, estimated from zero and from the guess that the
+// translation is `guess_t`; Error() is SampleMotionError against the true motion.
+struct TranslationStepsWithGuess {
+  TranslationStepsWithGuess(const Eigen::Vector3d& t, const Eigen::Vector3d& guess_t)
+      : before(testing::RenderGray(scene, scene.mesh.V)),
+        after(testing::RenderGray(scene, Translated(scene.mesh.V, t))),
+        truth(Translated(scene.control, t) - scene.control),
+        guess(Translated(scene.control, guess_t) - scene.control),
+        from_zero(estimator.Estimate(scene.control, before, after)),
+        from_guess(estimator.Estimate(scene.control, before, after, &guess)) {}
+  double Error(const Positions& displacement) const {
+    return SampleMotionError(estimator, scene.control, displacement, truth);
+  }
+  static Positions Translated(const Positions& points, const Eigen::Vector3d& t) {
+    RigidTransform motion;
+    motion.t = t;
+    return motion.Apply(points);
+  }
+
+  const MotionTestScene& scene = Scene();
+  const MotionStepEstimator estimator{scene.hierarchy, scene.cameras, scene.control};
+  const std::vector<cv::Mat> before, after;
+  const Positions truth, guess;
+  const MotionStep from_zero, from_guess;
+};
+
 // A translation of 1.5 mm (≈ 1 px in these 320×240 views, the blob's per-frame motion) is
 // recovered within 10 % (sample motion, mean over the samples seen twice) and the fitted
 // rigid translation within 10 % of its length.
@@ -84,53 +110,35 @@ TEST(MotionStep, RecoversAKnownTranslation) {
 // 1.4 mm (≈ 1 px) off — what the retrack pass has in the refined trajectories — the same
 // passes recover it several times closer (~0.3 %).
 TEST(MotionStep, AGuessNearTheMotionIsFollowedCloserThanAStartFromZero) {
-  const MotionTestScene& scene = Scene();
-  RigidTransform motion, near;
-  motion.t = Eigen::Vector3d(0.006, -0.004, 0.003);
-  near.t = motion.t + Eigen::Vector3d(0.001, 0.0008, -0.0006);
-  const MotionStepEstimator estimator(scene.hierarchy, scene.cameras, scene.control);
-  const std::vector<cv::Mat> before = testing::RenderGray(scene, scene.mesh.V);
-  const std::vector<cv::Mat> after = testing::RenderGray(scene, motion.Apply(scene.mesh.V));
-  const Positions truth = motion.Apply(scene.control) - scene.control;
-  const Positions guess = near.Apply(scene.control) - scene.control;
-  const MotionStep from_zero = estimator.Estimate(scene.control, before, after);
-  const MotionStep from_guess = estimator.Estimate(scene.control, before, after, &guess);
-  const double error_zero = SampleMotionError(estimator, scene.control, from_zero.displacement, truth);
-  const double error_guess = SampleMotionError(estimator, scene.control, from_guess.displacement, truth);
-  const double error_of_guess = SampleMotionError(estimator, scene.control, guess, truth);
+  const Eigen::Vector3d t(0.006, -0.004, 0.003);
+  const TranslationStepsWithGuess steps(t, t + Eigen::Vector3d(0.001, 0.0008, -0.0006));
+  const double error_zero = steps.Error(steps.from_zero.displacement);
+  const double error_guess = steps.Error(steps.from_guess.displacement);
+  const double error_of_guess = steps.Error(steps.guess);
   std::printf("translation |t| = %.1f mm: sample motion error from zero %.1f %%, guess itself %.1f %%, "
               "from the guess %.1f %%\n",
-              motion.t.norm() * 1e3, 100 * error_zero, 100 * error_of_guess, 100 * error_guess);
+              t.norm() * 1e3, 100 * error_zero, 100 * error_of_guess, 100 * error_guess);
   EXPECT_LT(error_zero, 0.10);
   EXPECT_LT(error_guess, 0.25 * error_zero);
   EXPECT_LT(error_guess, 0.1 * error_of_guess);
-  EXPECT_TRUE(from_guess.report.guess_used);
-  EXPECT_LT(from_guess.report.guess_rms, from_guess.report.guess_rms_zero);
+  EXPECT_TRUE(steps.from_guess.report.guess_used);
+  EXPECT_LT(steps.from_guess.report.guess_rms, steps.from_guess.report.guess_rms_zero);
   const Positions wrong = Positions::Zero(3, 3);
-  EXPECT_THROW(estimator.Estimate(scene.control, before, after, &wrong), Error);
+  EXPECT_THROW(steps.estimator.Estimate(steps.scene.control, steps.before, steps.after, &wrong), Error);
 }
 
 // A guess that matches the images worse than no motion (refined shapes that jump from frame
 // to frame, as on a real take whose tracking drifted: 12 mm, ≈ 8 px, the wrong way) is not a
 // start: the step is the one from zero, to the bit, and recovers the motion as well.
 TEST(MotionStep, AGuessWorseThanNoMotionIsIgnored) {
-  const MotionTestScene& scene = Scene();
-  RigidTransform motion, jump;
-  motion.t = Eigen::Vector3d(0.0012, -0.0007, 0.0006);
-  jump.t = Eigen::Vector3d(-0.008, 0.007, -0.006);
-  const MotionStepEstimator estimator(scene.hierarchy, scene.cameras, scene.control);
-  const std::vector<cv::Mat> before = testing::RenderGray(scene, scene.mesh.V);
-  const std::vector<cv::Mat> after = testing::RenderGray(scene, motion.Apply(scene.mesh.V));
-  const Positions truth = motion.Apply(scene.control) - scene.control;
-  const Positions guess = jump.Apply(scene.control) - scene.control;
-  const MotionStep from_zero = estimator.Estimate(scene.control, before, after);
-  const MotionStep from_guess = estimator.Estimate(scene.control, before, after, &guess);
-  const double error = SampleMotionError(estimator, scene.control, from_guess.displacement, truth);
+  const TranslationStepsWithGuess steps(Eigen::Vector3d(0.0012, -0.0007, 0.0006), Eigen::Vector3d(-0.008, 0.007, -0.006));
+  const MotionStepReport& report = steps.from_guess.report;
+  const double error = steps.Error(steps.from_guess.displacement);
   std::printf("guess 12 mm the wrong way: photometric RMS %.4f (guess) vs %.4f (zero), sample motion error %.1f %%\n",
-              from_guess.report.guess_rms, from_guess.report.guess_rms_zero, 100 * error);
-  EXPECT_FALSE(from_guess.report.guess_used);
-  EXPECT_GT(from_guess.report.guess_rms, from_guess.report.guess_rms_zero);
-  EXPECT_EQ(from_guess.displacement, from_zero.displacement);
+              report.guess_rms, report.guess_rms_zero, 100 * error);
+  EXPECT_FALSE(report.guess_used);
+  EXPECT_GT(report.guess_rms, report.guess_rms_zero);
+  EXPECT_EQ(steps.from_guess.displacement, steps.from_zero.displacement);
   EXPECT_LT(error, 0.10);
 }
 
