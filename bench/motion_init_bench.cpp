@@ -75,9 +75,13 @@ const Blob& GetBlob() {
   return blob;
 }
 
+// One motion step of the blob; the argument says whether the CG is preconditioned by the
+// V-cycle (1, the default) or by block Jacobi alone (0, the reference: as before 2026-12-04).
 void BM_MotionStep(benchmark::State& state) {
   const Blob& blob = GetBlob();
-  const solver::MotionStepEstimator estimator(blob.hierarchy, blob.dataset.cameras(), blob.fits[0]);
+  solver::MotionStepOptions options;
+  options.solver.multigrid = state.range(0) != 0;
+  const solver::MotionStepEstimator estimator(blob.hierarchy, blob.dataset.cameras(), blob.fits[0], options);
   const std::vector<cv::Mat> before = blob.Images(0), after = blob.Images(1);
   solver::MotionStep step;
   for (auto _ : state) step = estimator.Estimate(blob.fits[0], before, after);
@@ -92,7 +96,7 @@ void BM_MotionStep(benchmark::State& state) {
     state.counters["cg_last_" + std::to_string(level.level)] = level.cg_iterations;
   }
 }
-BENCHMARK(BM_MotionStep)->Unit(benchmark::kSecond)->MeasureProcessCPUTime()->UseRealTime()->Iterations(3);
+BENCHMARK(BM_MotionStep)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->MeasureProcessCPUTime()->UseRealTime()->Iterations(3);
 
 // Reference: the visibility stage alone (tessellation, 10 z-buffers, per-sample tests).
 void BM_VisibilityReference(benchmark::State& state) {

@@ -118,14 +118,15 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, standing, stil
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,
                                    tessellation_density)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(NormalFlowSolverOptions, smoothness, rigid_invariant_smoothness,
-                                   detail_damping, coarsest_level, finest_level, min_samples_per_face,
-                                   reweighting_iterations, robust_threshold, noise_floor, collinearity_pruning,
-                                   collinearity_min_cameras, cg_tolerance, cg_reweighting_tolerance,
-                                   cg_max_iterations)
+// WITH_DEFAULT: options files written before the newest fields existed still load (those
+// fields then take their defaults).
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalFlowSolverOptions, smoothness, rigid_invariant_smoothness,
+                                                detail_damping, coarsest_level, finest_level, min_samples_per_face,
+                                                reweighting_iterations, robust_threshold, noise_floor,
+                                                collinearity_pruning, collinearity_min_cameras, cg_tolerance,
+                                                cg_reweighting_tolerance, cg_max_iterations, multigrid)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solver, image_sigmas)
-// WITH_DEFAULT here and below: options files written before the newest fields existed
-// still load (those fields then take their defaults).
+// WITH_DEFAULT below too.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,
                                                 hull_iterations, guess_from_targets, concurrent_chains)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WindowSolverOptions, linear_solver, max_iterations, threads,

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "solver/motion/block_jacobi_preconditioner.h"
+#include "solver/motion/multigrid_preconditioner.h"
 
 namespace subflow::solver {
 BlockSparseMatrix MakeBlockSparse(const Eigen::SparseMatrix<double>& A) {
@@ -88,18 +89,14 @@ ConjugateGradientResult SolveConjugateGradient(const Eigen::SparseMatrix<double>
   return SolveConjugateGradient(MakeBlockSparse(A), b, tolerance, max_iterations, x);
 }
 
-ConjugateGradientResult SolveConjugateGradient(const BlockSparseMatrix& blocks, const Eigen::VectorXd& b,
-                                               double tolerance, int max_iterations, Eigen::VectorXd* x) {
-  SUBFLOW_CHECK(3 * static_cast<Eigen::Index>(blocks.blocks()) == b.size() && x->size() == b.size(),
-                "conjugate gradients: sizes differ");
+namespace {
+
+// The PCG iteration for any preconditioner with Eigen's solve(r) → z.
+template <typename Preconditioner>
+ConjugateGradientResult Iterate(const BlockSparseMatrix& blocks, const Preconditioner& preconditioner,
+                                const Eigen::VectorXd& b, double tolerance, int max_iterations, Eigen::VectorXd* x) {
   ConjugateGradientResult result;
   const double b_norm = b.norm();
-  if (b_norm == 0.0) {
-    x->setZero();
-    return result;
-  }
-  BlockJacobiPreconditioner preconditioner;
-  preconditioner.FactorizeBlocks(blocks);
   Eigen::VectorXd r(b.size()), Ap(b.size());
   MultiplySymmetric(blocks, *x, &Ap);
   r = b - Ap;
@@ -123,6 +120,31 @@ ConjugateGradientResult SolveConjugateGradient(const BlockSparseMatrix& blocks, 
   }
   result.relative_residual = r_norm / b_norm;
   return result;
+}
+
+}  // namespace
+
+ConjugateGradientResult SolveConjugateGradient(const BlockSparseMatrix& blocks, const Eigen::VectorXd& b,
+                                               double tolerance, int max_iterations, Eigen::VectorXd* x,
+                                               const MultigridPreconditioner* multigrid) {
+  SUBFLOW_CHECK(3 * static_cast<Eigen::Index>(blocks.blocks()) == b.size() && x->size() == b.size(),
+                "conjugate gradients: sizes differ");
+  if (b.norm() == 0.0) {
+    x->setZero();
+    return {};
+  }
+  if (multigrid) {
+    // A V-cycle whose smoothing diverged (ω from an estimate of λmax too low) is not a
+    // positive definite preconditioner: the iteration can stall or blow up. Then the
+    // solve is done again from the same start with block Jacobi.
+    const Eigen::VectorXd start = *x;
+    const ConjugateGradientResult result = Iterate(blocks, *multigrid, b, tolerance, max_iterations, x);
+    if (result.relative_residual <= tolerance && x->allFinite()) return result;
+    *x = start;
+  }
+  BlockJacobiPreconditioner preconditioner;
+  preconditioner.FactorizeBlocks(blocks);
+  return Iterate(blocks, preconditioner, b, tolerance, max_iterations, x);
 }
 
 }  // namespace subflow::solver

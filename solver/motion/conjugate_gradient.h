@@ -42,8 +42,12 @@ struct ConjugateGradientResult {
 ConjugateGradientResult SolveConjugateGradient(const Eigen::SparseMatrix<double>& A,
                                                const Eigen::VectorXd& b, double tolerance,
                                                int max_iterations, Eigen::VectorXd* x);
-// The same for A in block form (the same iterates as its scalar form, to the bit).
+// The same for A in block form (the same iterates as its scalar form, to the bit), with the
+// block-Jacobi preconditioner, or with `multigrid` (multigrid_preconditioner.h: a V-cycle
+// over the coarser levels, built for this A) when it is given.
+class MultigridPreconditioner;
 ConjugateGradientResult SolveConjugateGradient(const BlockSparseMatrix& A, const Eigen::VectorXd& b,
-                                               double tolerance, int max_iterations, Eigen::VectorXd* x);
+                                               double tolerance, int max_iterations, Eigen::VectorXd* x,
+                                               const MultigridPreconditioner* multigrid = nullptr);
 
 }  // namespace subflow::solver

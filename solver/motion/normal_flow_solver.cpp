@@ -2,17 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <spdlog/spdlog.h>
 
 #include "core/error.h"
+#include "core/stopwatch.h"
 #include "geometry/local_frames.h"
 #include "geometry/loop_operators.h"
 #include "solver/motion/conjugate_gradient.h"
 #include "solver/motion/constraint_collinearity.h"
+#include "solver/motion/multigrid_preconditioner.h"
 
 namespace subflow::solver {
 namespace {
@@ -25,6 +29,8 @@ using ConstVectorMap = Eigen::Map<const Eigen::VectorXd>;
 // Limit weights are O(1) (a row of L sums to 1); what the products L P_i leave of the
 // finest stencil's other ancestors cancels to ~1e-16.
 constexpr double kCancelledWeight = 1e-12;
+// μ_lo / κ_lo: the base level is not damped, only kept definite.
+constexpr double kBaseDamping = 1e-9;
 
 // A ⊗ I3 for a scalar sparse matrix A: entry (r, c) becomes the 3×3 block at (3r, 3c).
 template <typename Matrix>
@@ -171,7 +177,7 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
       Sparse identity(smoothness3_[level].rows(), smoothness3_[level].cols());
       identity.setIdentity();
       Sparse regularizer3 = options_.smoothness * length_ratio4_[level] * smoothness3_[level] +
-                            (level == lo_ ? 1e-9 : options_.detail_damping) * identity;
+                            (level == lo_ ? kBaseDamping : options_.detail_damping) * identity;
       regularizer3.makeCompressed();
       level_matrix_[level] = MakeLevelMatrix(data_pattern[level], regularizer3);
     }
@@ -347,8 +353,14 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
       const BlockSparseMatrix A = AssembleLevelBlocks(level_matrix_[level], data[level], report.data_stiffness);
       Eigen::VectorXd solution_vector = x;
+      const Stopwatch cg_start;
+      const std::unique_ptr<MultigridPreconditioner> multigrid =
+          options_.multigrid && level > lo_ ? MakeMultigrid(A, data, level, report.data_stiffness) : nullptr;
       const ConjugateGradientResult cg = SolveConjugateGradient(
-          A, rhs, cg_tolerance, options_.cg_max_iterations, &solution_vector);
+          A, rhs, cg_tolerance, options_.cg_max_iterations, &solution_vector, multigrid.get());
+      spdlog::debug("normal flow level {}: {} unknowns, {} blocks, {} CG iterations to {:.2g} in {:.3f} s{}", level,
+                    unknowns, A.row.size(), cg.iterations, cg.relative_residual, cg_start.Seconds(),
+                    multigrid ? " (multigrid)" : "");
       x = solution_vector;
       report.cg_iterations = cg.iterations;
       report.cg_error = cg.relative_residual;
@@ -363,6 +375,22 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       coarse_motion = hierarchy_->Refinement(level) * Positions(coarse_motion + delta);
   }
   *sample_motion_out = std::move(sample_motion);
+}
+
+std::unique_ptr<MultigridPreconditioner> NormalFlowSolver::MakeMultigrid(const BlockSparseMatrix& A,
+                                                                         const std::vector<std::vector<double>>& data,
+                                                                         int level, double stiffness) const {
+  std::vector<BlockSparseMatrix> coarse;
+  std::vector<const geometry::SparseMatrix*> refinement;
+  double scale = stiffness;
+  for (int j = level - 1; j >= lo_; --j) {
+    scale *= 4.0;  // the fine regularizer's weight on a net of ¼ the vertices (multigrid_preconditioner.h)
+    coarse.push_back(AssembleLevelBlocks(level_matrix_[j], data[j], scale));
+    // The base level's own regularizer has no damping; the fine level's has.
+    if (j == lo_) AddToBlockDiagonal((options_.detail_damping - kBaseDamping) * scale, &coarse.back());
+    refinement.push_back(&hierarchy_->Refinement(j));
+  }
+  return std::make_unique<MultigridPreconditioner>(A, std::move(coarse), std::move(refinement));
 }
 
 NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constraints,
