@@ -75,12 +75,15 @@ const Blob& GetBlob() {
   return blob;
 }
 
-// One motion step of the blob; the argument says whether the CG is preconditioned by the
-// V-cycle (1, the default) or by block Jacobi alone (0, the reference: as before 2026-12-04).
+// One motion step of the blob; the argument chooses the CG's preconditioner: 0 block Jacobi
+// alone (the reference: as before 2026-12-04), 1 the defaults (the V-cycle on levels of at
+// least multigrid_min_vertices control points: none of the blob's), 2 the V-cycle on every
+// level above the base.
 void BM_MotionStep(benchmark::State& state) {
   const Blob& blob = GetBlob();
   solver::MotionStepOptions options;
   options.solver.multigrid = state.range(0) != 0;
+  if (state.range(0) == 2) options.solver.multigrid_min_vertices = 0;
   const solver::MotionStepEstimator estimator(blob.hierarchy, blob.dataset.cameras(), blob.fits[0], options);
   const std::vector<cv::Mat> before = blob.Images(0), after = blob.Images(1);
   solver::MotionStep step;
@@ -96,7 +99,7 @@ void BM_MotionStep(benchmark::State& state) {
     state.counters["cg_last_" + std::to_string(level.level)] = level.cg_iterations;
   }
 }
-BENCHMARK(BM_MotionStep)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->MeasureProcessCPUTime()->UseRealTime()->Iterations(3);
+BENCHMARK(BM_MotionStep)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->MeasureProcessCPUTime()->UseRealTime()->Iterations(3);
 
 // Reference: the visibility stage alone (tessellation, 10 z-buffers, per-sample tests).
 void BM_VisibilityReference(benchmark::State& state) {

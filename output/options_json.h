@@ -124,7 +124,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalFlowSolverOptions, smoothn
                                                 detail_damping, coarsest_level, finest_level, min_samples_per_face,
                                                 reweighting_iterations, robust_threshold, noise_floor,
                                                 collinearity_pruning, collinearity_min_cameras, cg_tolerance,
-                                                cg_reweighting_tolerance, cg_max_iterations, multigrid)
+                                                cg_reweighting_tolerance, cg_max_iterations, multigrid,
+                                                multigrid_min_vertices)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solver, image_sigmas)
 // WITH_DEFAULT below too.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,

@@ -99,6 +99,8 @@ void NormalFlowSolverOptions::Check() const {
     ThrowError("normal flow solver", "min_samples_per_face", "expected a finite value ≥ 0");
   if (cg_max_iterations < 1)
     ThrowError("normal flow solver", "cg_max_iterations", "expected ≥ 1");
+  if (multigrid_min_vertices < 0)
+    ThrowError("normal flow solver", "multigrid_min_vertices", "expected ≥ 0 (control points of a level)");
 }
 
 NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
@@ -355,7 +357,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       Eigen::VectorXd solution_vector = x;
       const Stopwatch cg_start;
       const std::unique_ptr<MultigridPreconditioner> multigrid =
-          options_.multigrid && level > lo_ ? MakeMultigrid(A, data, level, report.data_stiffness) : nullptr;
+          options_.multigrid && level > lo_ && unknowns >= 3 * options_.multigrid_min_vertices ? MakeMultigrid(A, data, level, report.data_stiffness) : nullptr;
       const ConjugateGradientResult cg = SolveConjugateGradient(
           A, rhs, cg_tolerance, options_.cg_max_iterations, &solution_vector, multigrid.get());
       spdlog::debug("normal flow level {}: {} unknowns, {} blocks, {} CG iterations to {:.2g} in {:.3f} s{}", level,

@@ -99,10 +99,16 @@ struct NormalFlowSolverOptions {
   // to 4 digits; blob (3 levels, 12 frames): end-point error 0.04169 → 0.04168 relative.
   double cg_reweighting_tolerance = 1e-3;
   int cg_max_iterations = 500;
-  // Precondition the CG of every level above the coarsest by a V-cycle over the coarser
-  // levels (multigrid_preconditioner.h) instead of block Jacobi alone: the same solution to
-  // the same tolerance in far fewer iterations (docs/speed.md).
+  // Precondition the CG of the levels above the coarsest with at least
+  // multigrid_min_vertices control points by a V-cycle over the coarser levels
+  // (multigrid_preconditioner.h) instead of block Jacobi alone: the same solution to the
+  // same tolerance in far fewer iterations, for a setup (power iterations, the base level's
+  // Cholesky factor) that small levels do not repay. Measured (docs/speed.md): pose2sim
+  // level 2 (8,196 control points) 250–500 → 4–5 iterations, 4.3× faster; its level 1
+  // (2,052) 85–248 → 4–5, as fast; the blob's level 1 (642) 57 → 3 iterations but a step
+  // 17 % slower.
   bool multigrid = true;
+  int multigrid_min_vertices = 2000;
 
   void Check() const;  // throws subflow::Error naming the field
 };

@@ -39,10 +39,24 @@ const std::vector<std::unique_ptr<SignedDistanceImage>>& FrameImageCache::Silhou
   return silhouette_cache_.emplace(frame, std::move(distances)).first->second;
 }
 
+const SampleVisibilityFlags* FrameImageCache::Visibility(int frame, const Positions& control) const {
+  const auto it = visibility_cache_.find(frame);
+  if (it == visibility_cache_.end() || it->second.first.rows() != control.rows() || it->second.first != control)
+    return nullptr;
+  return &it->second.second;
+}
+
+void FrameImageCache::KeepVisibility(int frame, const Positions& control, SampleVisibilityFlags visible) {
+  visibility_cache_[frame] = {control, std::move(visible)};
+}
+
 void FrameImageCache::Release(int first_kept) {
-  for (auto it = gray_cache_.begin(); it != gray_cache_.end();) it = it->first < first_kept ? gray_cache_.erase(it) : ++it;
-  for (auto it = silhouette_cache_.begin(); it != silhouette_cache_.end();)
-    it = it->first < first_kept ? silhouette_cache_.erase(it) : ++it;
+  const auto release = [first_kept](auto& cache) {
+    for (auto it = cache.begin(); it != cache.end();) it = it->first < first_kept ? cache.erase(it) : ++it;
+  };
+  release(gray_cache_);
+  release(silhouette_cache_);
+  release(visibility_cache_);
 }
 
 RefinementLevel PrepareLevel(const LoopHierarchy& hierarchy, const std::vector<vision::Camera>& cameras,
@@ -84,10 +98,14 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& h
     if (window.active_faces[f])
       for (int k = 0; k < 3; ++k) window.active_vertices[F(f, k)] = 1;
   const int c0 = std::max(0, first - 1), c1 = std::min(window.frame_count - 1, last + 1);
-  for (int f = c0; f <= c1; ++f)
+  for (int f = c0; f <= c1; ++f) {
+    const SampleVisibilityFlags* known = images->Visibility(f, control[f]);
+    SampleVisibilityFlags decided;
     window.states.emplace(f, MakeFrameState(hierarchy, level.level, level.dof, trajectory[f], control[f],
                                             level.sampling, *level.visibility, cameras, images->Silhouettes(f),
-                                            options.outline_margin));
+                                            options.outline_margin, known, known ? nullptr : &decided));
+    if (!known) images->KeepVisibility(f, control[f], std::move(decided));
+  }
   return window;
 }
 
@@ -96,7 +114,8 @@ FrameState MakeFrameState(const LoopHierarchy& hierarchy, int level, int dof,
                           const LevelSampling& sampling, const VisibilityTester& tester,
                           const std::vector<vision::Camera>& cameras,
                           const std::vector<std::unique_ptr<SignedDistanceImage>>& silhouettes,
-                          double outline_margin) {
+                          double outline_margin, const SampleVisibilityFlags* known,
+                          SampleVisibilityFlags* decided) {
   FrameState state;
   std::vector<geometry::LocalFrames> frames;
   state.level_control = shape.Synthesize(hierarchy, level, &frames);
@@ -126,7 +145,8 @@ FrameState MakeFrameState(const LoopHierarchy& hierarchy, int level, int dof,
   state.normals.resize(state.positions.rows(), 3);
   for (Eigen::Index s = 0; s < du.rows(); ++s)
     state.normals.row(s) = du.row(s).cross(dv.row(s)).normalized();
-  state.usable = tester.Compute(cameras, finest_control, state.positions, state.normals).visible;
+  state.usable = known ? *known : tester.Compute(cameras, finest_control, state.positions, state.normals).visible;
+  if (decided) *decided = state.usable;
   tbb::parallel_for(0, static_cast<int>(cameras.size()), [&](int k) {
     if (!silhouettes[k]) return;
     for (Eigen::Index s = 0; s < state.positions.rows(); ++s) {

@@ -37,8 +37,18 @@ namespace subflow::solver {
 struct StereoRefinementOptions;
 class ViewCache;
 
-// The images of the frames a window needs, smoothed (σ = image_sigma) and the silhouettes'
-// signed distances, each computed once and released when no later window needs them.
+// Per camera and sample: visible or not (SampleVisibility::visible).
+using SampleVisibilityFlags = std::vector<std::vector<std::uint8_t>>;
+
+// What the windows of a level share per frame: the images a window needs, smoothed (σ =
+// image_sigma), the silhouettes' signed distances, and the visibility of the level's
+// samples; each computed once and released when no later window needs it.
+//
+// A frame's visibility is kept for the next window of the same level and round while the
+// frame's shape has not changed: the context frame after a window (held constant there)
+// is the next window's frame, and its z-buffers are not rendered again. A frame a window
+// solved is decided again on its new shape (reusing the old decision instead changed the
+// results: docs/speed.md).
 class FrameImageCache {
  public:
   FrameImageCache(const vision::ImageSequence& images, double sigma);
@@ -47,6 +57,12 @@ class FrameImageCache {
   const std::vector<SmoothedImage>& Gray(int frame);
   // Per camera: the signed distance to the silhouette's outline at `frame`, or null.
   const std::vector<std::unique_ptr<SignedDistanceImage>>& Silhouettes(int frame);
+  // The visibility of the current level's samples at `frame` as decided for the finest
+  // control points `control`, or null when it was not (or for another shape).
+  const SampleVisibilityFlags* Visibility(int frame, const geometry::Positions& control) const;
+  void KeepVisibility(int frame, const geometry::Positions& control, SampleVisibilityFlags visible);
+  // Forgets every frame's visibility (a new level or round).
+  void ForgetVisibility() { visibility_cache_.clear(); }
   // Forgets the frames before `first_kept`.
   void Release(int first_kept);
 
@@ -55,6 +71,7 @@ class FrameImageCache {
   double sigma_;
   std::map<int, std::vector<SmoothedImage>> gray_cache_;
   std::map<int, std::vector<std::unique_ptr<SignedDistanceImage>>> silhouette_cache_;
+  std::map<int, std::pair<geometry::Positions, SampleVisibilityFlags>> visibility_cache_;
 };
 
 struct FrameState {
@@ -121,11 +138,14 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const geometry::LoopHi
 
 // The state of one frame at level ℓ: `shape` and `finest_control` are the frame's current
 // multires shape and finest control points; `silhouettes` its signed distances per camera.
+// The samples' visibility is `known` when given, else decided by `tester` on the current
+// shape (and then written to `decided` when given).
 FrameState MakeFrameState(const geometry::LoopHierarchy& hierarchy, int level, int dof,
                           const geometry::MultiresShape& shape, const geometry::Positions& finest_control,
                           const LevelSampling& sampling, const VisibilityTester& tester,
                           const std::vector<vision::Camera>& cameras,
                           const std::vector<std::unique_ptr<SignedDistanceImage>>& silhouettes,
-                          double outline_margin);
+                          double outline_margin, const SampleVisibilityFlags* known = nullptr,
+                          SampleVisibilityFlags* decided = nullptr);
 
 }  // namespace subflow::solver

@@ -98,6 +98,7 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   const auto windows = Windows(frames, options.window, options.window_overlap);
   report.windows = static_cast<int>(windows.size());
   for (int round = 0; round < options.rounds; ++round) {
+    cache->ForgetVisibility();  // another level's samples, or another round
     report.parameters = 0;
     report.residual_blocks = 0;
     report.iterative_windows = 0;

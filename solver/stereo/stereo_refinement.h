@@ -32,7 +32,9 @@
 //     the working volume (the paper's inequality constraints).
 // NCC blocks use a Cauchy loss (occlusions the z-buffer misses, specularities).
 //
-// Visibility and samples are recomputed `rounds` times per level as the shape changes.
+// Visibility and samples are recomputed `rounds` times per level as the shape changes;
+// visibility for every window whose frame changed since the last decision
+// (refinement_window.h: FrameImageCache).
 // Adaptivity: at level ℓ + 1 only the patches whose parent's corners moved by more than
 // adaptive_threshold · h_ℓ at level ℓ (in some frame) are refined, and, below the median
 // resolved level, only those that still cover min_patch_area (patch_levels.h); the rest
