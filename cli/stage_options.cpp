@@ -107,6 +107,9 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
   sub->add_flag("!--no-shadow-test", o->silhouettes.background_shadow_test,
                 "Background difference without the shadow test (a darkening that keeps the background's "
                 "texture then counts as object)");
+  sub->add_flag("--concavities", o->concavities.enabled,
+                "Carve every frame's visual hull where the images see through it (hollows no silhouette reaches; "
+                "vision/concavity_carving.h; off by default, see docs/shape.md)");
 }
 
 void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o) {

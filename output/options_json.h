@@ -89,6 +89,10 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SupportPlaneOptions, tolerance, iterations, s
                                    min_above_fraction, seed)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StillEvidenceOptions, enabled, sweep, fusion, remove_support_plane,
                                    support_plane, support_tolerance_planes)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ConcavityCarvingOptions, enabled, every_frame, sweep, fusion, min_neighbours,
+                                   pixels_per_voxel, surface_margin_voxels, opening_radius, min_depth,
+                                   max_carved_fraction,
+                                   min_component_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VoxelCarvingOptions, resolution, pixels_per_voxel, max_auto_resolution,
                                    max_pixels_per_voxel,
                                    min_cameras, max_misses, evidence_threshold, footprint_margin, closing_radius,
@@ -112,8 +116,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_dista
 namespace subflow::solver {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ShapeInitOptions, silhouettes, standing, still, carving, isosurface, simplify, fit,
-                                   base_distance_voxels, levels, finest_edge_pixels, max_finest_faces,
+// WITH_DEFAULT: options files written before `concavities` existed still load.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ShapeInitOptions, silhouettes, standing, still, carving, concavities,
+                                   isosurface, simplify, fit, base_distance_voxels, levels, finest_edge_pixels, max_finest_faces,
                                    reference_frame, first_frame, frame_count, image_edge_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,

@@ -29,6 +29,67 @@ float MapAt(const cv::Mat& inverse_depth, const Eigen::Vector2d& pixel) {
   return inverse_depth.at<float>(v, u);
 }
 
+// What camera c says about a voxel of edge s centred at X: it sees it (X projects into its
+// image, in front of it); it frees it (a trusted pixel of the voxel's footprint — a box of
+// its half diagonal — sees a surface behind it, and none sees one at it or in front); it
+// hits it (some pixel sees a surface at it or in front).
+struct FreeSpaceVote {
+  bool sees = false, frees = false, hits = false;
+};
+
+class FreeSpaceVoter {
+ public:
+  FreeSpaceVoter(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& trusted,
+                 const std::vector<double>& steps, double voxel_size, const DepthFusionOptions& options,
+                 double margin = 0.0)
+      : cameras_(cameras), trusted_(trusted), steps_(steps), half_diagonal_(0.5 * std::sqrt(3.0) * voxel_size),
+        margin_(margin), free_space_planes_(options.free_space_planes) {}
+
+  FreeSpaceVote Vote(int c, const Eigen::Vector3d& X) const {
+    FreeSpaceVote vote;
+    const Camera& camera = cameras_[c];
+    double depth = 0;
+    const Eigen::Vector2d pixel = camera.Project(X, &depth);
+    if (depth <= 0 || !camera.InImage(pixel)) return vote;
+    vote.sees = true;
+    const double q = 1.0 / depth;
+    const double tolerance = free_space_planes_ * steps_[c] + (half_diagonal_ + margin_) * q * q;
+    const double radius = half_diagonal_ * q * 0.5 * (camera.K()(0, 0) + camera.K()(1, 1));
+    const cv::Mat& map = trusted_[c];
+    const int u0 = std::max(0, static_cast<int>(std::ceil(pixel.x() - radius))),
+              u1 = std::min(map.cols - 1, static_cast<int>(std::floor(pixel.x() + radius)));
+    const int v0 = std::max(0, static_cast<int>(std::ceil(pixel.y() - radius))),
+              v1 = std::min(map.rows - 1, static_cast<int>(std::floor(pixel.y() + radius)));
+    int through = 0, surface = 0;
+    for (int v = v0; v <= v1; ++v)
+      for (int u = u0; u <= u1; ++u) {
+        const float Q = map.at<float>(v, u);
+        if (Q < 0) continue;
+        through += q - Q > tolerance;
+        surface += Q >= q - tolerance;  // a surface at the voxel or in front of it
+      }
+    vote.frees = through > 0 && surface == 0;
+    vote.hits = surface > 0;
+    return vote;
+  }
+
+ private:
+  const std::vector<Camera>& cameras_;
+  const std::vector<cv::Mat>& trusted_;
+  const std::vector<double>& steps_;
+  double half_diagonal_, margin_, free_space_planes_;
+};
+
+void CheckTrustedMaps(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& trusted,
+                      const std::vector<double>& steps) {
+  if (trusted.size() != cameras.size() || steps.size() != cameras.size())
+    ThrowError("depth fusion", "depth maps", "expected one map and one plane step per camera");
+  for (std::size_t k = 0; k < cameras.size(); ++k)
+    if (trusted[k].type() != CV_32FC1 || trusted[k].cols != cameras[k].width() ||
+        trusted[k].rows != cameras[k].height())
+      ThrowError("depth fusion", "depth map of camera " + cameras[k].name(), "expected CV_32FC1 of the camera's size");
+}
+
 }  // namespace
 
 void DepthFusionOptions::Check() const {
@@ -91,12 +152,7 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
                              const SupportPlane* support, const DepthFusionOptions& options) {
   options.Check();
   Stopwatch start;
-  if (trusted.size() != cameras.size() || steps.size() != cameras.size())
-    ThrowError("depth fusion", "depth maps", "expected one map and one plane step per camera");
-  for (std::size_t k = 0; k < cameras.size(); ++k)
-    if (trusted[k].type() != CV_32FC1 || trusted[k].cols != cameras[k].width() ||
-        trusted[k].rows != cameras[k].height())
-      ThrowError("depth fusion", "depth map of camera " + cameras[k].name(), "expected CV_32FC1 of the camera's size");
+  CheckTrustedMaps(cameras, trusted, steps);
   const int count = static_cast<int>(cameras.size());
   FusedOccupancy result;
   const bool remove_plane = support != nullptr && support->found;
@@ -104,7 +160,7 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
   // Free space, per voxel.
   result.occupancy = MakeVoxelGrid(bounds, resolution);
   geometry::ScalarVolume& grid = result.occupancy;
-  const double half_diagonal = 0.5 * std::sqrt(3.0) * grid.spacing;
+  const FreeSpaceVoter voter(cameras, trusted, steps, grid.spacing, options);
   tbb::parallel_for(0, grid.nz, [&](int k) {
     for (int j = 0; j < grid.ny; ++j)
       for (int i = 0; i < grid.nx; ++i) {
@@ -112,29 +168,10 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
         if (remove_plane && support->SignedDistance(X) <= support->tolerance) continue;
         int seen = 0, freed = 0, hits = 0;
         for (int c = 0; c < count && freed < options.free_votes; ++c) {
-          double depth = 0;
-          const Eigen::Vector2d pixel = cameras[c].Project(X, &depth);
-          if (depth <= 0 || !cameras[c].InImage(pixel)) continue;
-          ++seen;
-          // The trusted pixels of the voxel's footprint (a box of its half diagonal's size).
-          const double q = 1.0 / depth;
-          const double tolerance = options.free_space_planes * steps[c] + half_diagonal * q * q;
-          const double radius = half_diagonal * q * 0.5 * (cameras[c].K()(0, 0) + cameras[c].K()(1, 1));
-          const cv::Mat& map = trusted[c];
-          const int u0 = std::max(0, static_cast<int>(std::ceil(pixel.x() - radius))),
-                    u1 = std::min(map.cols - 1, static_cast<int>(std::floor(pixel.x() + radius)));
-          const int v0 = std::max(0, static_cast<int>(std::ceil(pixel.y() - radius))),
-                    v1 = std::min(map.rows - 1, static_cast<int>(std::floor(pixel.y() + radius)));
-          int through = 0, surface = 0;
-          for (int v = v0; v <= v1; ++v)
-            for (int u = u0; u <= u1; ++u) {
-              const float Q = map.at<float>(v, u);
-              if (Q < 0) continue;
-              through += q - Q > tolerance;
-              surface += Q >= q - tolerance;  // a surface at the voxel or in front of it
-            }
-          freed += through > 0 && surface == 0;
-          hits += surface > 0;
+          const FreeSpaceVote vote = voter.Vote(c, X);
+          seen += vote.sees;
+          freed += vote.frees;
+          hits += vote.hits;
         }
         if (freed < options.free_votes && seen >= options.min_cameras && hits >= options.min_hits)
           grid.at(i, j, k) = 1.0f;
@@ -144,6 +181,33 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
   result.occupied_voxels = static_cast<std::size_t>(std::count(grid.values.begin(), grid.values.end(), 1.0f));
   result.seconds = start.Seconds();
   return result;
+}
+
+std::size_t CarveSeenThrough(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& trusted,
+                             const std::vector<double>& steps, const DepthFusionOptions& options,
+                             double margin, geometry::ScalarVolume* occupancy) {
+  options.Check();
+  CheckTrustedMaps(cameras, trusted, steps);
+  if (!(margin >= 0)) ThrowError("depth fusion", "margin", "expected ≥ 0");
+  const int free_votes = options.free_votes;
+  geometry::ScalarVolume& grid = *occupancy;
+  const FreeSpaceVoter voter(cameras, trusted, steps, grid.spacing, options, margin);
+  const int count = static_cast<int>(cameras.size());
+  std::vector<std::size_t> carved(grid.nz, 0);
+  // Votes are read from the input occupancy only (the maps), so the order does not matter.
+  tbb::parallel_for(0, grid.nz, [&](int k) {
+    for (int j = 0; j < grid.ny; ++j)
+      for (int i = 0; i < grid.nx; ++i) {
+        if (grid.at(i, j, k) <= 0.5f) continue;
+        const Eigen::Vector3d X = grid.VoxelCenter(i, j, k);
+        int freed = 0;
+        for (int c = 0; c < count && freed < free_votes; ++c) freed += voter.Vote(c, X).frees;
+        if (freed >= free_votes) grid.at(i, j, k) = 0.0f, ++carved[k];
+      }
+  });
+  std::size_t total = 0;
+  for (std::size_t n : carved) total += n;
+  return total;
 }
 
 }  // namespace subflow::vision

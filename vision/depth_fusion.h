@@ -81,4 +81,14 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
                              const std::vector<double>& steps, const Bounds& bounds, int resolution,
                              const SupportPlane* support, const DepthFusionOptions& options = {});
 
+// Step 2 inside a given occupancy (0 / 1, e.g. a visual hull): every occupied voxel that at
+// least options.free_votes cameras free (see through it, as above) is emptied; nothing is
+// added, and no camera is asked to hit a voxel (space that no trusted depth reaches keeps
+// what the occupancy says). `margin` (world units, ≥ 0) is added to the depth tolerance:
+// nothing within it of a measured surface is emptied. Returns the voxels emptied. Every
+// vote reads the maps only, so the result does not depend on the order of the voxels.
+std::size_t CarveSeenThrough(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& trusted,
+                             const std::vector<double>& steps, const DepthFusionOptions& options, double margin,
+                             geometry::ScalarVolume* occupancy);
+
 }  // namespace subflow::vision

@@ -89,7 +89,8 @@ ReferenceRays TraceRays(const Camera& camera, const Bounds& bounds) {
   return rays;
 }
 
-// Neighbours of camera r (see the header).
+}  // namespace
+
 std::vector<int> ChooseNeighbours(const std::vector<Camera>& cameras, int r, const PlaneSweepOptions& options) {
   std::vector<std::pair<double, int>> candidates;
   const double scale = 1e-9 * (1.0 + cameras[r].Center().norm());
@@ -104,6 +105,8 @@ std::vector<int> ChooseNeighbours(const std::vector<Camera>& cameras, int r, con
   for (int i = 0; i < std::min<int>(options.neighbours, candidates.size()); ++i) chosen.push_back(candidates[i].second);
   return chosen;
 }
+
+namespace {
 
 // The pixel of camera `target` that the point at inverse depth q on reference ray (x, y, 1)
 // projects to: X_target ∝ R (x, y, 1) + q b (q = 0: the point at infinity).
@@ -316,6 +319,31 @@ cv::Mat BestViewsScore(const std::vector<cv::Mat>& ncc, int views) {
   return quantized;
 }
 
+// The box of the pixels to measure (inside the volume, and `known` when given), grown by
+// the NCC window's radius plus one and then out to nodes of the whole image's map grid
+// (kGridStep): every window of a measured pixel lies inside it and the maps are
+// interpolated between the same nodes, so the sweep on the box gives those pixels exactly
+// what it gives on the whole image.
+cv::Rect MeasuredBox(const ReferenceRays& rays, const cv::Mat& known, int window_radius) {
+  cv::Mat measured = rays.q_near >= 0;
+  if (!known.empty()) measured &= known != 0;
+  const cv::Rect box = cv::boundingRect(measured);
+  if (box.empty()) return box;
+  const int grow = window_radius + 1, w = rays.x.cols, h = rays.x.rows;
+  const auto node_below = [](int i) { return std::max(0, i) / kGridStep * kGridStep; };
+  const auto node_above = [](int i, int last) { return std::min(last, (i + kGridStep - 1) / kGridStep * kGridStep); };
+  const int u0 = node_below(box.x - grow), v0 = node_below(box.y - grow);
+  const int u1 = node_above(box.x + box.width - 1 + grow, w - 1), v1 = node_above(box.y + box.height - 1 + grow, h - 1);
+  return cv::Rect(u0, v0, u1 - u0 + 1, v1 - v0 + 1);
+}
+
+// `rays` restricted to `box` (views, no copies; q_min / q_max kept).
+ReferenceRays Crop(const ReferenceRays& rays, const cv::Rect& box) {
+  ReferenceRays cropped = rays;
+  cropped.x = rays.x(box), cropped.y = rays.y(box), cropped.q_near = rays.q_near(box), cropped.q_far = rays.q_far(box);
+  return cropped;
+}
+
 DepthMap SweepOne(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& gray, const Bounds& bounds,
                   const PlaneSweepOptions& options, const cv::Mat& known, int r) {
   Stopwatch start;
@@ -325,19 +353,28 @@ DepthMap SweepOne(const std::vector<Camera>& cameras, const std::vector<cv::Mat>
   result.inverse_depth = cv::Mat(h, w, CV_32F, cv::Scalar(kNotSwept));
   result.score = cv::Mat(h, w, CV_32F, cv::Scalar(kNone));
   result.neighbours = ChooseNeighbours(cameras, r, options);
-  const ReferenceRays rays = TraceRays(camera, bounds);
-  if (result.neighbours.empty() || !(rays.q_min < rays.q_max)) return result;
+  const ReferenceRays all_rays = TraceRays(camera, bounds);
+  if (result.neighbours.empty() || !(all_rays.q_min < all_rays.q_max)) return result;
+  result.inverse_depth.setTo(kNoDepth, all_rays.q_near >= 0);
   std::vector<RayTransfer> transfers;
-  std::vector<NeighbourGrid> grids;
   for (int j : result.neighbours) transfers.emplace_back(camera, cameras[j]);
-  for (const RayTransfer& transfer : transfers) grids.push_back(MakeGrid(rays, transfer));
-  const double q_low = options.sweep_beyond_volume ? 0.0 : rays.q_min, q_high = rays.q_max;
-  const int planes = CountPlanes(rays, transfers, q_low, q_high, options);
+  const double q_low = options.sweep_beyond_volume ? 0.0 : all_rays.q_min, q_high = all_rays.q_max;
+  const int planes = CountPlanes(all_rays, transfers, q_low, q_high, options);
   result.planes = planes;
   result.inverse_depth_step = (q_high - q_low) / (planes - 1);
   const int views = std::min<int>(options.consistent_views, transfers.size());
 
-  const ReferenceStatistics reference = MakeStatistics(gray[r], options);
+  // Everything below works on the box of the pixels measured.
+  const cv::Rect box = MeasuredBox(all_rays, known, options.window_radius);
+  if (box.empty()) {
+    result.seconds = start.Seconds();
+    return result;
+  }
+  const ReferenceRays rays = Crop(all_rays, box);
+  std::vector<NeighbourGrid> grids;
+  for (const RayTransfer& transfer : transfers) grids.push_back(MakeGrid(rays, transfer));
+  const ReferenceStatistics full = MakeStatistics(gray[r], options);
+  const ReferenceStatistics reference{full.image(box), full.mean(box), full.variance(box)};
 
   // Scores of every plane (8 bits), kept for the uniqueness test.
   std::vector<cv::Mat> volume(planes);
@@ -350,25 +387,29 @@ DepthMap SweepOne(const std::vector<Camera>& cameras, const std::vector<cv::Mat>
   }
 
   // Best plane, uniqueness, texture, known.
-  result.inverse_depth.setTo(kNoDepth, rays.q_near >= 0);
   const auto decode = [](uchar q) { return q / 127.5f - 1.0f; };
-  for (int v = 0; v < h; ++v)
-    for (int u = 0; u < w; ++u) {
-      if (!known.empty() && !known.at<uchar>(v, u)) continue;
+  std::vector<uchar> scores(planes);
+  for (int v = 0; v < box.height; ++v)
+    for (int u = 0; u < box.width; ++u) {
+      const int image_u = box.x + u, image_v = box.y + v;
+      if (rays.q_near.at<float>(v, u) < 0) continue;
+      if (!known.empty() && !known.at<uchar>(image_v, image_u)) continue;
       if (std::sqrt(reference.variance.at<float>(v, u)) < options.min_texture) continue;
       int best = -1;
       uchar best_q = 0;
-      for (int i = 0; i < planes; ++i)
-        if (volume[i].at<uchar>(v, u) > best_q) best_q = volume[i].at<uchar>(v, u), best = i;
+      for (int i = 0; i < planes; ++i) {
+        scores[i] = volume[i].at<uchar>(v, u);
+        if (scores[i] > best_q) best_q = scores[i], best = i;
+      }
       if (best < 0) continue;
       const float best_score = decode(best_q);
       if (best_score < options.min_score) continue;
       uchar rival_q = 0;
       for (int i = 0; i < planes; ++i)
-        if (std::abs(i - best) > options.uniqueness_planes) rival_q = std::max(rival_q, volume[i].at<uchar>(v, u));
+        if (std::abs(i - best) > options.uniqueness_planes) rival_q = std::max(rival_q, scores[i]);
       if (best_score - decode(rival_q) < options.uniqueness_margin) continue;
-      result.inverse_depth.at<float>(v, u) = static_cast<float>(plane_q(best));
-      result.score.at<float>(v, u) = best_score;
+      result.inverse_depth.at<float>(image_v, image_u) = static_cast<float>(plane_q(best));
+      result.score.at<float>(image_v, image_u) = best_score;
       ++result.pixels_with_depth;
     }
   result.seconds = start.Seconds();

@@ -114,6 +114,10 @@ PlaneHypothesis ScorePlane(const std::vector<Camera>& cameras, const std::vector
                            const std::vector<int>& neighbours, const Eigen::Vector3d& normal, double offset,
                            const PlaneSweepOptions& options = {});
 
+// The neighbours camera r is compared with (see the file comment), nearest in viewing
+// direction first.
+std::vector<int> ChooseNeighbours(const std::vector<Camera>& cameras, int r, const PlaneSweepOptions& options = {});
+
 // The world point of pixel (u, v) of `camera` at depth z (z along the optical axis).
 Eigen::Vector3d PointAtDepth(const Camera& camera, const Eigen::Vector2d& pixel, double z);
 

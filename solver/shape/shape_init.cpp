@@ -84,10 +84,12 @@ void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std:
 struct HullStage {
   const vision::Dataset& dataset;
   const vision::VoxelCarvingOptions& carving;
+  const vision::ConcavityCarvingOptions& concavities;
   const geometry::IsosurfaceOptions& isosurface;
   const std::vector<vision::Camera>& cameras;  // the evidence's working cameras
   const std::vector<vision::EstimatedBackground>& estimated;
   const std::vector<vision::Silhouette>* standing = nullptr;
+  int reference_frame = -1;  // the only frame whose concavities are carved unless every_frame
 
   void Run(const vision::SilhouetteOptions& silhouette_options, const std::vector<vision::Silhouette>* still,
            Progress* progress, std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
@@ -112,6 +114,8 @@ struct HullStage {
       });
       if ((*has_evidence)[i]) {
         frame.carving = vision::CarveVoxels(cameras, silhouettes, dataset.bounds(), carving, frame.frame);
+        if (concavities.enabled && (concavities.every_frame || frame.frame == reference_frame))
+          CarveFrameConcavities(&frame);
         frame.carve_seconds = start.Seconds();
         start.Restart();
         const geometry::TriangleMesh hull = geometry::ExtractIsosurface(
@@ -125,6 +129,25 @@ struct HullStage {
       ProgressUpdate(progress, i + 1);
     }
     ProgressEnd(progress);
+  }
+
+  // The frame's hull carved where its images see through it (vision/concavity_carving.h).
+  void CarveFrameConcavities(FrameShapeInit* frame) const {
+    std::vector<cv::Mat> gray(cameras.size());
+    for (std::size_t k = 0; k < cameras.size(); ++k)
+      gray[k] = vision::ResizeToCamera(dataset.Gray(static_cast<int>(k), frame->frame), cameras[k]);
+    frame->concavities = vision::CarveConcavities(cameras, gray, concavities, &frame->carving.occupancy);
+    const vision::ConcavityCarvingReport& report = frame->concavities;
+    if (!report.skipped.empty() && report.carved_voxels > 0) {
+      const std::string warning = "frame " + std::to_string(frame->frame) + ": concavity carving not applied: " +
+                                  report.skipped;
+      spdlog::warn("{}", warning);
+      frame->carving.warnings.push_back(warning);
+    }
+    spdlog::debug("frame {}: concavities carved {} of {} hull voxels ({} removed with cleaning), {} trusted "
+                  "depths, {:.2f} s",
+                  frame->frame, report.carved_voxels, report.hull_voxels, report.removed_voxels,
+                  report.trusted_pixels, report.seconds);
   }
 };
 
@@ -225,6 +248,7 @@ void ShapeInitOptions::Check() const {
   standing.Check();
   still.Check();
   carving.Check();
+  concavities.Check();
   isosurface.Check();
   simplify.Check();
   fit.Check();
@@ -293,8 +317,9 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   // Visual hull of every frame with evidence; when no frame has any, of the still set.
   std::vector<bool> has_evidence(count, false), all_empty(count, false);
   result.standing = StandingSilhouettes(result.estimated_backgrounds, options);
-  const HullStage stage{dataset, carving, options.isosurface, evidence_cameras, result.estimated_backgrounds,
-                        result.standing.empty() ? nullptr : &result.standing};
+  const HullStage stage{dataset,          carving, options.concavities, options.isosurface, evidence_cameras,
+                        result.estimated_backgrounds, result.standing.empty() ? nullptr : &result.standing,
+                        reference};
   const bool still_forced = options.silhouettes.source == vision::EvidenceSource::kStill;
   std::vector<vision::Silhouette> still;
   if (still_forced) still = StillSilhouettes(dataset, reference, evidence_cameras, carving.resolution, options, &result);

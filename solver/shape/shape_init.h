@@ -29,6 +29,7 @@
 #include "geometry/simplify.h"
 #include "solver/shape/base_resolution.h"
 #include "solver/shape/hierarchy_fit.h"
+#include "vision/concavity_carving.h"
 #include "vision/dataset.h"
 #include "vision/silhouettes.h"
 #include "vision/standing_evidence.h"
@@ -48,6 +49,9 @@ struct ShapeInitOptions {
   // camera (vision/still_evidence.h) is every frame's evidence.
   vision::StillEvidenceOptions still;
   vision::VoxelCarvingOptions carving;
+  // Every frame's hull is carved where the cameras see through it (concavities the
+  // silhouettes cannot reach: vision/concavity_carving.h).
+  vision::ConcavityCarvingOptions concavities;
   geometry::IsosurfaceOptions isosurface;
   // T0's simplification: its filters, the face count when base_distance_voxels = 0, the
   // face floor and cap of the distance bound (min_face_count, max_face_count) otherwise.
@@ -96,12 +100,13 @@ struct FrameShapeInit {
   // taken, with a warning in carving.warnings.
   int hull_from_frame = 0;
   vision::CarvingResult carving;             // figures; its occupancy volume is released
+  vision::ConcavityCarvingReport concavities;  // the hull's carving by free space
   geometry::IsosurfaceSummary isosurface;
   geometry::TriangleMesh hull;               // the visual-hull iso-surface H_f (empty with a ShapeFrameStore)
   int hull_vertices = 0, hull_faces = 0;     // the hull's size (with or without a store)
   std::vector<geometry::Positions> control;  // fitted control points, levels 0..n (empty with a store)
   std::vector<LevelFitSummary> fit;          // per level
-  double carve_seconds = 0, isosurface_seconds = 0, fit_seconds = 0;
+  double carve_seconds = 0, isosurface_seconds = 0, fit_seconds = 0;  // carve: with the concavities
 };
 
 // Where InitializeShape keeps each frame's visual hull and fitted control points. Without

@@ -79,6 +79,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--background-threshold", {"0.07", "/options/shape_init/silhouettes/background_threshold", 0.07}},
       {"--background-noise-factor", {"4.5", "/options/shape_init/silhouettes/background_noise_factor", 4.5}},
       {"--no-shadow-test", {"", "/options/shape_init/silhouettes/background_shadow_test", false}},
+      {"--concavities", {"", "/options/shape_init/concavities/enabled", true}},
       {"--motion-smoothness", {"0.004", "/options/motion_init/step/solver/smoothness", 0.004}},
       {"--hull-weight", {"0.4", "/options/motion_init/hull_weight", 0.4}},
       {"--refine-from", {"1", "/options/refinement/coarsest_level", 1}},
