@@ -8,6 +8,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "core/error.h"
+#include "solver/motion/row_product.h"
 
 namespace subflow::solver {
 namespace {
@@ -16,21 +17,9 @@ using Vector = Eigen::VectorXd;
 
 // y = S x for a per-vertex operator S applied to interleaved (x, y, z) vectors.
 Vector ApplyPerVertex(const geometry::SparseMatrix& S, const Vector& x) {
-  Vector y = Vector::Zero(3 * S.rows());
-  for (Eigen::Index r = 0; r < S.outerSize(); ++r) {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    for (geometry::SparseMatrix::InnerIterator it(S, r); it; ++it) {
-      const double w = it.value();
-      const double* in = x.data() + 3 * it.col();
-      s0 += w * in[0];
-      s1 += w * in[1];
-      s2 += w * in[2];
-    }
-    y(3 * r) = s0;
-    y(3 * r + 1) = s1;
-    y(3 * r + 2) = s2;
-  }
-  return y;
+  const RowMajorColumns<3> y =
+      RowParallelProduct<3>(S, Eigen::Map<const RowMajorColumns<3>>(x.data(), x.size() / 3, 3));
+  return Eigen::Map<const Vector>(y.data(), y.size());
 }
 
 Vector Multiply(const BlockSparseMatrix& A, const Vector& x) {

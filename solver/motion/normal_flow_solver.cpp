@@ -17,6 +17,7 @@
 #include "solver/motion/conjugate_gradient.h"
 #include "solver/motion/constraint_collinearity.h"
 #include "solver/motion/multigrid_preconditioner.h"
+#include "solver/motion/row_product.h"
 
 namespace subflow::solver {
 namespace {
@@ -44,28 +45,6 @@ Sparse Kron3(const Matrix& A) {
                               it.value());
   Sparse result(3 * A.rows(), 3 * A.cols());
   result.setFromTriplets(triplets.begin(), triplets.end());
-  return result;
-}
-
-// A B for row-major sparse A and row-major B with a fixed number of columns, parallel over
-// A's rows; each row sums its entries in order (the same sums as Eigen's product).
-template <int Columns>
-Eigen::Matrix<double, Eigen::Dynamic, Columns, Eigen::RowMajor> RowParallelProduct(
-    const geometry::SparseMatrix& A, const Eigen::Matrix<double, Eigen::Dynamic, Columns, Eigen::RowMajor>& B) {
-  SUBFLOW_CHECK(A.cols() == B.rows(), "product of mismatched sizes");
-  Eigen::Matrix<double, Eigen::Dynamic, Columns, Eigen::RowMajor> result(A.rows(), Columns);
-  tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(A.rows()), 2048),
-                    [&](const tbb::blocked_range<int>& range) {
-    for (int r = range.begin(); r < range.end(); ++r) {
-      double sum[Columns] = {};
-      for (int k = A.outerIndexPtr()[r]; k < A.outerIndexPtr()[r + 1]; ++k) {
-        const double w = A.valuePtr()[k];
-        const double* b = B.row(A.innerIndexPtr()[k]).data();
-        for (int i = 0; i < Columns; ++i) sum[i] += w * b[i];
-      }
-      for (int i = 0; i < Columns; ++i) result(r, i) = sum[i];
-    }
-  });
   return result;
 }
 
@@ -249,13 +228,13 @@ std::vector<double> NormalFlowSolver::DataSums(
   // the product E M of the entries' weights and the samples' blocks, gathered entry by
   // entry in parallel (each entry's samples added in ascending order: deterministic, no
   // per-thread copies of the sums to clear and add up).
-  const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> sums = RowParallelProduct(stencils.entry_weights, M);
+  const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> sums = RowParallelProduct<6>(stencils.entry_weights, M);
   return std::vector<double>(sums.data(), sums.data() + sums.size());
 }
 
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
   SUBFLOW_CHECK(displacement.rows() == limit_.cols(), "displacement of another level");
-  return RowParallelProduct(limit_, displacement);
+  return RowParallelProduct<3>(limit_, displacement);
 }
 
 std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
@@ -349,15 +328,16 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
           sample_rhs(s, 2) = h(s, 2) - (m6[2] * u0 + m6[4] * u1 + m6[5] * u2);
         }
       });
-      const Positions data_rhs = RowParallelProduct(level_limit_transpose_[level], sample_rhs);
+      const Positions data_rhs = RowParallelProduct<3>(level_limit_transpose_[level], sample_rhs);
       const Eigen::VectorXd rhs = ConstVectorMap(data_rhs.data(), unknowns) -
                                   report.smoothness_weight * (smoothness3_[level] * W);
       // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
       const BlockSparseMatrix A = AssembleLevelBlocks(level_matrix_[level], data[level], report.data_stiffness);
       Eigen::VectorXd solution_vector = x;
       const Stopwatch cg_start;
+      const bool cycle = options_.multigrid && level > lo_ && unknowns >= 3 * options_.multigrid_min_vertices;
       const std::unique_ptr<MultigridPreconditioner> multigrid =
-          options_.multigrid && level > lo_ && unknowns >= 3 * options_.multigrid_min_vertices ? MakeMultigrid(A, data, level, report.data_stiffness) : nullptr;
+          cycle ? MakeMultigrid(A, data, level, report.data_stiffness) : nullptr;
       const ConjugateGradientResult cg = SolveConjugateGradient(
           A, rhs, cg_tolerance, options_.cg_max_iterations, &solution_vector, multigrid.get());
       spdlog::debug("normal flow level {}: {} unknowns, {} blocks, {} CG iterations to {:.2g} in {:.3f} s{}", level,
@@ -370,7 +350,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
       x.setZero();
     }
     D += P3 * x;
-    sample_motion += RowParallelProduct(level_limit, delta);
+    sample_motion += RowParallelProduct<3>(level_limit, delta);
     solution->cg_iterations += report.cg_iterations;
     solution->levels.push_back(report);
     if (level < hi_)
