@@ -90,7 +90,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SupportPlaneOptions, tolerance, iterations, s
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StillEvidenceOptions, enabled, sweep, fusion, remove_support_plane,
                                    support_plane, support_tolerance_planes)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ConcavityCarvingOptions, enabled, every_frame, sweep, fusion, min_neighbours,
-                                   pixels_per_voxel, surface_margin_voxels, opening_radius, min_depth,
+                                   pixels_per_voxel, surface_margin_voxels, surface_veto, opening_radius, min_depth,
                                    max_carved_fraction,
                                    min_component_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VoxelCarvingOptions, resolution, pixels_per_voxel, max_auto_resolution,

@@ -177,7 +177,8 @@ ConcavityCarvingReport CarveConcavities(const std::vector<Camera>& cameras, cons
   }
   geometry::ScalarVolume carved = *occupancy;
   report.carved_voxels = CarveSeenThrough(swept, trusted, steps, options.fusion,
-                                          options.surface_margin_voxels * occupancy->spacing, &carved);
+                                          options.surface_margin_voxels * occupancy->spacing,
+                                          options.surface_veto, &carved);
   if (report.carved_voxels > 0) {
     if (options.opening_radius > 0) KeepWideCarving(*occupancy, options.opening_radius, &carved);
     if (options.min_depth > 0) KeepDeepCarving(*occupancy, options.min_depth, &carved);

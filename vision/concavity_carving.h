@@ -16,8 +16,8 @@
 //      TrustedDepths), so a chance match of one pair carves nothing;
 //   3. every hull voxel that at least `fusion.free_votes` cameras see through (a trusted
 //      depth behind it by more than the depth tolerance plus surface_margin_voxels, none
-//      at it or in front) is emptied (depth_fusion.h: CarveSeenThrough); nothing is ever
-//      added;
+//      at it or in front), and at which no camera measures a surface (surface_veto), is
+//      emptied (depth_fusion.h: CarveSeenThrough); nothing is ever added;
 //   4. the empty space after carving (outside the hull, and emptied) is opened by a box of
 //      radius opening_radius: only emptied voxels that such a box of free space covers
 //      stay empty. The hull's margin trimmed along its surface and a hollow opened to the
@@ -30,12 +30,12 @@
 //   6. the carved hull is cleaned as the hull was: components smaller than
 //      min_component_fraction of the largest removed, interior cavities filled.
 //
-// Off by default. Measured (docs/shape.md, 2026-12-05): on the synthetic scenes it opens
+// Off by default. Measured (docs/shape.md, 2026-12-05): without the surface veto it opens
 // the mug's cup and the space under the critter (observed accuracy P90 4.13 -> 2.09 px and
 // 1.26 -> 1.13 px), but on ../shared/data/blob (rendered by Blender) it costs 6 % in
-// accuracy and on an untextured sphere wrong depths from shading cut into the object; the
-// settings that avoid both (three cameras seeing through, a margin of 1.5 voxels) leave
-// almost nothing carved.
+// accuracy and on an untextured sphere wrong depths from shading cut into the object.
+// With the veto (the default of these options) the blob and the sphere stay as they were
+// and the gains are small (mug 3.36 px, critter 1.23 px), for ~1 s a frame.
 //
 // Texture-less surface gives no depth and so carves nothing: the hull stays where the
 // images cannot say. As a guard against depth maps gone wrong (repetitive texture, a
@@ -79,6 +79,10 @@ struct ConcavityCarvingOptions {
   // depth tolerance (step 3), so that depths wrong by a plane or two cannot cut into the
   // object (0 = the tolerance alone).
   double surface_margin_voxels = 0.0;
+  // A voxel at which some camera measures a surface is never emptied (step 3): the free
+  // space a wrong depth behind the surface implies crosses the surface other cameras
+  // measure. Keeps the blob and an untextured sphere whole (docs/shape.md).
+  bool surface_veto = true;
   // Only emptied voxels inside a box of radius opening_radius (voxels) of empty space stay
   // empty (step 4; 0 = every emptied voxel).
   int opening_radius = 1;

@@ -35,6 +35,7 @@ float MapAt(const cv::Mat& inverse_depth, const Eigen::Vector2d& pixel) {
 // hits it (some pixel sees a surface at it or in front).
 struct FreeSpaceVote {
   bool sees = false, frees = false, hits = false;
+  bool at = false;  // some pixel sees a surface at the voxel (within the tolerance)
 };
 
 class FreeSpaceVoter {
@@ -60,16 +61,18 @@ class FreeSpaceVoter {
               u1 = std::min(map.cols - 1, static_cast<int>(std::floor(pixel.x() + radius)));
     const int v0 = std::max(0, static_cast<int>(std::ceil(pixel.y() - radius))),
               v1 = std::min(map.rows - 1, static_cast<int>(std::floor(pixel.y() + radius)));
-    int through = 0, surface = 0;
+    int through = 0, surface = 0, at = 0;
     for (int v = v0; v <= v1; ++v)
       for (int u = u0; u <= u1; ++u) {
         const float Q = map.at<float>(v, u);
         if (Q < 0) continue;
         through += q - Q > tolerance;
         surface += Q >= q - tolerance;  // a surface at the voxel or in front of it
+        at += std::abs(Q - q) <= tolerance;
       }
     vote.frees = through > 0 && surface == 0;
     vote.hits = surface > 0;
+    vote.at = at > 0;
     return vote;
   }
 
@@ -185,7 +188,7 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
 
 std::size_t CarveSeenThrough(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& trusted,
                              const std::vector<double>& steps, const DepthFusionOptions& options,
-                             double margin, geometry::ScalarVolume* occupancy) {
+                             double margin, bool veto_at_surface, geometry::ScalarVolume* occupancy) {
   options.Check();
   CheckTrustedMaps(cameras, trusted, steps);
   if (!(margin >= 0)) ThrowError("depth fusion", "margin", "expected ≥ 0");
@@ -201,8 +204,13 @@ std::size_t CarveSeenThrough(const std::vector<Camera>& cameras, const std::vect
         if (grid.at(i, j, k) <= 0.5f) continue;
         const Eigen::Vector3d X = grid.VoxelCenter(i, j, k);
         int freed = 0;
-        for (int c = 0; c < count && freed < free_votes; ++c) freed += voter.Vote(c, X).frees;
-        if (freed >= free_votes) grid.at(i, j, k) = 0.0f, ++carved[k];
+        bool surface = false;
+        for (int c = 0; c < count && !(surface && veto_at_surface); ++c) {
+          const FreeSpaceVote vote = voter.Vote(c, X);
+          freed += vote.frees;
+          surface = surface || vote.at;
+        }
+        if (freed >= free_votes && !(surface && veto_at_surface)) grid.at(i, j, k) = 0.0f, ++carved[k];
       }
   });
   std::size_t total = 0;

@@ -85,10 +85,14 @@ FusedOccupancy FuseDepthMaps(const std::vector<Camera>& cameras, const std::vect
 // least options.free_votes cameras free (see through it, as above) is emptied; nothing is
 // added, and no camera is asked to hit a voxel (space that no trusted depth reaches keeps
 // what the occupancy says). `margin` (world units, ≥ 0) is added to the depth tolerance:
-// nothing within it of a measured surface is emptied. Returns the voxels emptied. Every
-// vote reads the maps only, so the result does not depend on the order of the voxels.
+// nothing within it of a measured surface is emptied. With `veto_at_surface`, a voxel at
+// which any camera measures a surface (a trusted depth within the tolerance of the
+// voxel's) is kept whatever the others see through: the free space a wrong depth behind
+// the surface implies crosses the surface that other cameras measure. Returns the voxels
+// emptied. Every vote reads the maps only, so the result does not depend on the order of
+// the voxels.
 std::size_t CarveSeenThrough(const std::vector<Camera>& cameras, const std::vector<cv::Mat>& trusted,
                              const std::vector<double>& steps, const DepthFusionOptions& options, double margin,
-                             geometry::ScalarVolume* occupancy);
+                             bool veto_at_surface, geometry::ScalarVolume* occupancy);
 
 }  // namespace subflow::vision

@@ -115,6 +115,22 @@ TEST(ShapeInit, HullOfAConvexObjectContainsItAndLiesWithinThreeVoxels) {
   }
 }
 
+// Carving hollows by free space (vision/concavity_carving.h) on this untextured sphere:
+// its depths come from shading alone, and without the surface veto 99–117 of its 2,562
+// true vertices fall outside the carved hull; with it the hull still holds the sphere.
+TEST(ShapeInit, CarvingHollowsKeepsAConvexObjectInsideItsHull) {
+  const fs::path directory = Scratch().FreshPath("convex_concavities");
+  vision::WriteSyntheticDataset(directory.string(), SphereOptions("dome", 10, 160, 120, 2));
+  const vision::Dataset dataset(directory.string());
+  ShapeInitOptions options = QuickOptions();
+  options.concavities.enabled = true;
+  const ShapeInitResult result = InitializeShape(dataset, options);
+  for (const FrameShapeInit& frame : result.frames) {
+    EXPECT_GT(frame.concavities.trusted_pixels, 0) << "frame " << frame.frame << ": " << frame.concavities.skipped;
+    EXPECT_LE(ExpectContainsTruthAndHausdorff(dataset, frame), 3.0 * VoxelSize(dataset, frame));
+  }
+}
+
 // Mean distance of the hull's vertices from the true sphere (outside positive).
 double MeanExcess(const vision::Dataset& dataset, const FrameShapeInit& frame) {
   const SphereFit sphere = TrueSphere(dataset, frame.frame);
