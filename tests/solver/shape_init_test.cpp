@@ -116,7 +116,7 @@ TEST(ShapeInit, HullOfAConvexObjectContainsItAndLiesWithinThreeVoxels) {
 }
 
 // Carving hollows by free space (vision/concavity_carving.h) on this untextured sphere:
-// its depths come from shading alone, and without the surface veto 99–117 of its 2,562
+// its depths come from shading alone, and without the surface veto 337-372 of its 2,562
 // true vertices fall outside the carved hull; with it the hull still holds the sphere.
 TEST(ShapeInit, CarvingHollowsKeepsAConvexObjectInsideItsHull) {
   const fs::path directory = Scratch().FreshPath("convex_concavities");
