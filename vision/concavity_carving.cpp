@@ -142,10 +142,6 @@ ConcavityCarvingReport CarveConcavities(const std::vector<Camera>& cameras, cons
     return report;
   }
   const std::size_t count = cameras.size();
-  std::vector<double> scales(count, 1.0);
-  for (std::size_t k = 0; k < count; ++k)
-    scales[k] = EvidenceScale(cameras[k], box, occupancy->spacing, options.pixels_per_voxel);
-  const std::vector<Camera> swept = ScaledCameras(cameras, scales);
   // The rig must have at least 2 cameras with min_neighbours neighbours (then every
   // camera measures).
   int dense = 0;
@@ -158,6 +154,10 @@ ConcavityCarvingReport CarveConcavities(const std::vector<Camera>& cameras, cons
     report.seconds = start.Seconds();
     return report;
   }
+  std::vector<double> scales(count, 1.0);
+  for (std::size_t k = 0; k < count; ++k)
+    scales[k] = EvidenceScale(cameras[k], box, occupancy->spacing, options.pixels_per_voxel);
+  const std::vector<Camera> swept = ScaledCameras(cameras, scales);
   std::vector<cv::Mat> images(count), known(count);
   for (std::size_t k = 0; k < count; ++k) {
     if (gray[k].size() != cv::Size(cameras[k].width(), cameras[k].height()) || gray[k].type() != CV_32FC1)

@@ -203,14 +203,16 @@ std::size_t CarveSeenThrough(const std::vector<Camera>& cameras, const std::vect
       for (int i = 0; i < grid.nx; ++i) {
         if (grid.at(i, j, k) <= 0.5f) continue;
         const Eigen::Vector3d X = grid.VoxelCenter(i, j, k);
+        // Without the veto the count may stop at free_votes; with it every camera is asked
+        // until one measures a surface at the voxel.
         int freed = 0;
-        bool surface = false;
-        for (int c = 0; c < count && !(surface && veto_at_surface); ++c) {
+        bool vetoed = false;
+        for (int c = 0; c < count && !vetoed && (veto_at_surface || freed < free_votes); ++c) {
           const FreeSpaceVote vote = voter.Vote(c, X);
           freed += vote.frees;
-          surface = surface || vote.at;
+          vetoed = veto_at_surface && vote.at;
         }
-        if (freed >= free_votes && !(surface && veto_at_surface)) grid.at(i, j, k) = 0.0f, ++carved[k];
+        if (freed >= free_votes && !vetoed) grid.at(i, j, k) = 0.0f, ++carved[k];
       }
   });
   std::size_t total = 0;

@@ -77,6 +77,15 @@ void TakeHullsOfFramesWithoutEvidence(const vision::Dataset& dataset, const std:
   }
 }
 
+// Every camera's gray image of `frame` at the size of its working camera.
+std::vector<cv::Mat> WorkingGrayImages(const vision::Dataset& dataset, int frame,
+                                       const std::vector<vision::Camera>& cameras) {
+  std::vector<cv::Mat> gray(cameras.size());
+  for (std::size_t k = 0; k < cameras.size(); ++k)
+    gray[k] = vision::ResizeToCamera(dataset.Gray(static_cast<int>(k), frame), cameras[k]);
+  return gray;
+}
+
 // The visual hull of every frame (FrameShapeInit's carving, hull and times) from the
 // evidence of `silhouettes` (plus `standing`, when given), or from `still` for every frame
 // when given; has_evidence / all_empty per frame as TakeHullsOfFramesWithoutEvidence
@@ -133,10 +142,8 @@ struct HullStage {
 
   // The frame's hull carved where its images see through it (vision/concavity_carving.h).
   void CarveFrameConcavities(FrameShapeInit* frame) const {
-    std::vector<cv::Mat> gray(cameras.size());
-    for (std::size_t k = 0; k < cameras.size(); ++k)
-      gray[k] = vision::ResizeToCamera(dataset.Gray(static_cast<int>(k), frame->frame), cameras[k]);
-    frame->concavities = vision::CarveConcavities(cameras, gray, concavities, &frame->carving.occupancy);
+    frame->concavities = vision::CarveConcavities(cameras, WorkingGrayImages(dataset, frame->frame, cameras),
+                                                  concavities, &frame->carving.occupancy);
     const vision::ConcavityCarvingReport& report = frame->concavities;
     if (!report.skipped.empty() && report.carved_voxels > 0) {
       const std::string warning = "frame " + std::to_string(frame->frame) + ": concavity carving not applied: " +
@@ -167,10 +174,8 @@ std::vector<vision::Silhouette> StandingSilhouettes(const std::vector<vision::Es
 std::vector<vision::Silhouette> StillSilhouettes(const vision::Dataset& dataset, int reference,
                                                  const std::vector<vision::Camera>& cameras, int resolution,
                                                  const ShapeInitOptions& options, ShapeInitResult* result) {
-  std::vector<cv::Mat> gray(cameras.size());
-  for (std::size_t k = 0; k < cameras.size(); ++k)
-    gray[k] = vision::ResizeToCamera(dataset.Gray(static_cast<int>(k), reference), cameras[k]);
-  result->still = vision::ComputeStillEvidence(cameras, gray, dataset.bounds(), resolution, options.still);
+  result->still = vision::ComputeStillEvidence(cameras, WorkingGrayImages(dataset, reference, cameras),
+                                               dataset.bounds(), resolution, options.still);
   result->used_still = true;
   std::vector<vision::Silhouette> silhouettes(cameras.size());
   for (std::size_t k = 0; k < cameras.size(); ++k) {
