@@ -116,9 +116,11 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SimplifyOptions, target_face_count, max_dista
 namespace subflow::solver {
 
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(HierarchyFitOptions, iterations_per_level, max_snap_distance)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceRegistrationOptions, enabled, iterations, stiffness_start, stiffness_end,
+                                   point_weight, max_distance_edges, min_normal_cosine, min_start_distance_edges)
 // WITH_DEFAULT: options files written before `concavities` existed still load.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(ShapeInitOptions, silhouettes, standing, still, carving, concavities,
-                                   isosurface, simplify, fit, base_distance_voxels, levels, finest_edge_pixels, max_finest_faces,
+                                   isosurface, simplify, registration, fit, base_distance_voxels, levels, finest_edge_pixels, max_finest_faces,
                                    reference_frame, first_frame, frame_count, image_edge_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SurfaceSamplingOptions, samples_per_pixel, max_density)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(VisibilityOptions, depth_tolerance, min_view_cosine, image_margin,

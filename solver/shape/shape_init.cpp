@@ -196,7 +196,7 @@ std::vector<vision::Silhouette> StillSilhouettes(const vision::Dataset& dataset,
 // starts from its neighbour's fitted base, the frame fitted last on its side of the
 // reference frame: only those two bases are kept. Returns the reference frame's finest
 // control points.
-geometry::Positions FitEveryFrame(const HierarchyFitOptions& options, ShapeFrameStore* store, Progress* progress,
+geometry::Positions FitEveryFrame(const ShapeInitOptions& options, ShapeFrameStore* store, Progress* progress,
                                   ShapeInitResult* result) {
   const int count = static_cast<int>(result->frames.size());
   const int reference_index = result->reference_frame - result->frames.front().frame;
@@ -207,6 +207,7 @@ geometry::Positions FitEveryFrame(const HierarchyFitOptions& options, ShapeFrame
     if (reference_index + d < count) order.push_back(reference_index + d);
   }
   int done = 0;
+  const SurfaceRegistration registration(*result->hierarchy, options.registration);
   geometry::Positions base_before, base_after, reference_control;  // sides i < and i > reference_index
   for (int i : order) {
     FrameShapeInit& frame = result->frames[i];
@@ -215,8 +216,12 @@ geometry::Positions FitEveryFrame(const HierarchyFitOptions& options, ShapeFrame
         i == reference_index ? result->base_mesh.V : (i < reference_index ? base_before : base_after);
     const geometry::ClosestPointTree hull_tree(store->LoadHull(frame.frame),
                                                "visual hull of frame " + vision::FrameName(frame.frame));
+    // The reference frame's base is its own hull simplified: nothing to follow there.
+    const geometry::Positions registered = i == reference_index
+                                               ? initial_base
+                                               : registration.Register(initial_base, hull_tree, &frame.registration);
     const std::vector<geometry::Positions> control =
-        FitHierarchyToSurface(*result->hierarchy, initial_base, hull_tree, options, &frame.fit);
+        FitHierarchyToSurface(*result->hierarchy, registered, hull_tree, options.fit, &frame.fit);
     frame.fit_seconds = start.Seconds();
     if (i == reference_index) {
       base_before = base_after = control.front();
@@ -256,6 +261,7 @@ void ShapeInitOptions::Check() const {
   concavities.Check();
   isosurface.Check();
   simplify.Check();
+  registration.Check();
   fit.Check();
   if (levels < -1 || levels > 6) ThrowError("shape init options", "levels", "expected 0..6, or −1 for automatic");
   if (!(base_distance_voxels >= 0 && base_distance_voxels <= 100))
@@ -361,7 +367,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
                result.base_mesh.vertex_count(), result.base_mesh.face_count(), levels,
                result.hierarchy->FaceCount(levels));
 
-  result.reference_control = FitEveryFrame(options.fit, store, progress, &result);
+  result.reference_control = FitEveryFrame(options, store, progress, &result);
   return result;
 }
 

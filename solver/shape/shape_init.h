@@ -29,6 +29,7 @@
 #include "geometry/simplify.h"
 #include "solver/shape/base_resolution.h"
 #include "solver/shape/hierarchy_fit.h"
+#include "solver/shape/surface_registration.h"
 #include "vision/concavity_carving.h"
 #include "vision/dataset.h"
 #include "vision/silhouettes.h"
@@ -56,6 +57,10 @@ struct ShapeInitOptions {
   // T0's simplification: its filters, the face count when base_distance_voxels = 0, the
   // face floor and cap of the distance bound (min_face_count, max_face_count) otherwise.
   geometry::SimplifyOptions simplify;
+  // Every frame's fit starts from its neighbour's fitted base registered to the frame's
+  // hull (non-rigid ICP, solver/shape/surface_registration.h), so that the surface
+  // follows parts that moved by more than a snap along the normals reaches.
+  SurfaceRegistrationOptions registration;
   HierarchyFitOptions fit;
   // T0 = the reference hull simplified until it would leave this many voxels (of the
   // carving grid) of the hull, both ways (solver/shape/base_resolution.h); 0 = by count
@@ -105,6 +110,7 @@ struct FrameShapeInit {
   geometry::TriangleMesh hull;               // the visual-hull iso-surface H_f (empty with a ShapeFrameStore)
   int hull_vertices = 0, hull_faces = 0;     // the hull's size (with or without a store)
   std::vector<geometry::Positions> control;  // fitted control points, levels 0..n (empty with a store)
+  SurfaceRegistrationReport registration;    // the starting base registered to the hull
   std::vector<LevelFitSummary> fit;          // per level
   double carve_seconds = 0, isosurface_seconds = 0, fit_seconds = 0;  // carve: with the concavities
 };

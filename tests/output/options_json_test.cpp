@@ -66,6 +66,7 @@ TEST(OptionsJson, EveryFieldOfEveryOptionsStructIsRecordedAndReadsBack) {
   ExpectEveryFieldRecorded<geometry::IsosurfaceOptions>("IsosurfaceOptions");
   ExpectEveryFieldRecorded<geometry::SimplifyOptions>("SimplifyOptions");
   ExpectEveryFieldRecorded<solver::HierarchyFitOptions>("HierarchyFitOptions");
+  ExpectEveryFieldRecorded<solver::SurfaceRegistrationOptions>("SurfaceRegistrationOptions");
   ExpectEveryFieldRecorded<solver::ShapeInitOptions>("ShapeInitOptions");
   ExpectEveryFieldRecorded<solver::SurfaceSamplingOptions>("SurfaceSamplingOptions");
   ExpectEveryFieldRecorded<solver::VisibilityOptions>("VisibilityOptions");
