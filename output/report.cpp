@@ -58,6 +58,28 @@ nlohmann::json ReportHead(const CommandRun& run, const vision::Dataset& dataset)
           {"dataset", DatasetJson(dataset)}};
 }
 
+namespace {
+
+nlohmann::json ConcavitiesJson(const vision::ConcavityCarvingReport& r) {
+  return {{"applied", r.applied},           {"skipped", r.skipped},
+          {"hull_voxels", r.hull_voxels},   {"carved_voxels", r.carved_voxels},
+          {"removed_voxels", r.removed_voxels}, {"trusted_pixels", r.trusted_pixels},
+          {"seconds", r.seconds}};
+}
+
+nlohmann::json RegistrationJson(const solver::SurfaceRegistrationReport& r) {
+  return {{"applied", r.applied},
+          {"iterations", r.iterations},
+          {"mean_surface_distance_before", r.mean_surface_distance_before},
+          {"mean_surface_distance_after", r.mean_surface_distance_after},
+          {"mean_target_distance_before", r.mean_target_distance_before},
+          {"mean_target_distance_after", r.mean_target_distance_after},
+          {"reachable_target_distance_before", r.reachable_target_distance_before},
+          {"seconds", r.seconds}};
+}
+
+}  // namespace
+
 nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::ShapeInitOptions& options,
                              const solver::ShapeInitResult& result) {
   const auto& hierarchy = *result.hierarchy;
@@ -139,24 +161,12 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
                       {"components_kept", frame.carving.components_kept},
                       {"cavity_voxels_filled", frame.carving.cavity_voxels_filled},
                       {"border_voxels", frame.carving.border_voxels},
-                      {"concavities", {{"applied", frame.concavities.applied},
-                                       {"skipped", frame.concavities.skipped},
-                                       {"hull_voxels", frame.concavities.hull_voxels},
-                                       {"carved_voxels", frame.concavities.carved_voxels},
-                                       {"removed_voxels", frame.concavities.removed_voxels},
-                                       {"trusted_pixels", frame.concavities.trusted_pixels},
-                                       {"seconds", frame.concavities.seconds}}},
+                      {"concavities", ConcavitiesJson(frame.concavities)},
                       {"mean_silhouette_iou", Finite(frame.carving.mean_silhouette_iou)},
                       {"cameras", cameras},
                       {"warnings", frame.carving.warnings},
                       {"hull", {{"vertices", frame.hull_vertices}, {"faces", frame.hull_faces}}},
-                      {"registration", {{"applied", frame.registration.applied},
-                                        {"iterations", frame.registration.iterations},
-                                        {"mean_surface_distance_before", frame.registration.mean_surface_distance_before},
-                                        {"mean_surface_distance_after", frame.registration.mean_surface_distance_after},
-                                        {"mean_target_distance_before", frame.registration.mean_target_distance_before},
-                                        {"mean_target_distance_after", frame.registration.mean_target_distance_after},
-                                        {"seconds", frame.registration.seconds}}},
+                      {"registration", RegistrationJson(frame.registration)},
                       {"fit", fit_levels},
                       {"seconds", {{"carve", frame.carve_seconds},
                                    {"isosurface", frame.isosurface_seconds},

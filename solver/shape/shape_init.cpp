@@ -10,6 +10,7 @@
 
 #include "core/stopwatch.h"
 #include "geometry/closest_point.h"
+#include "geometry/mean_edge_length.h"
 #include "core/error.h"
 #include "vision/working_scale.h"
 
@@ -207,7 +208,9 @@ geometry::Positions FitEveryFrame(const ShapeInitOptions& options, ShapeFrameSto
     if (reference_index + d < count) order.push_back(reference_index + d);
   }
   int done = 0;
-  const SurfaceRegistration registration(*result->hierarchy, options.registration);
+  const SurfaceRegistration registration(
+      *result->hierarchy, options.registration,
+      geometry::MeanEdgeLength(result->hierarchy->Topology(0), result->base_mesh.V));
   geometry::Positions base_before, base_after, reference_control;  // sides i < and i > reference_index
   for (int i : order) {
     FrameShapeInit& frame = result->frames[i];

@@ -83,6 +83,7 @@ struct TargetSample {
 struct Distances {
   double surface = 0.0;  // mean, limit points → target
   double target = 0.0;   // mean, target samples → limit mesh
+  double reachable = 0.0;  // mean over the samples within the correspondence distance
 };
 
 // Per limit point: the 3×3 block B and vector B·p of its data terms (w [n nᵀ + β I]).
@@ -118,10 +119,12 @@ Distances Correspond(const geometry::TriangleMesh& limit_mesh, const geometry::C
   const geometry::ClosestPointTree surface(limit_mesh, "registered surface");
   const Positions surface_normals = geometry::FaceNormals(limit_mesh.V, limit_mesh.F);
   const std::vector<geometry::SurfacePoint> backward = surface.ClosestPoints(sample.points);
+  int reachable = 0;
   const double backward_weight = 1.0 / std::max<Eigen::Index>(1, sample.points.rows());
   for (Eigen::Index j = 0; j < sample.points.rows(); ++j) {
     const geometry::SurfacePoint& hit = backward[j];
     distances.target += hit.distance * backward_weight;
+    if (hit.distance <= max_distance) distances.reachable += hit.distance, ++reachable;
     if (!terms || hit.face < 0 || hit.distance > max_distance) continue;
     const Eigen::Vector3d n = sample.normals.row(j).transpose();
     if (n.dot(surface_normals.row(hit.face).transpose()) < options.min_normal_cosine) continue;
@@ -132,6 +135,7 @@ Distances Correspond(const geometry::TriangleMesh& limit_mesh, const geometry::C
     terms->Add(limit_mesh.F(hit.face, corner), sample.points.row(j).transpose(), n, backward_weight,
                options.point_weight);
   }
+  if (reachable > 0) distances.reachable /= reachable;
   return distances;
 }
 
@@ -140,6 +144,7 @@ Distances Correspond(const geometry::TriangleMesh& limit_mesh, const geometry::C
 struct SurfaceRegistration::Impl {
   const geometry::LoopHierarchy& hierarchy;
   SurfaceRegistrationOptions options;
+  double edge_length = 0.0;  // ≤ 0: each start's own
   int evaluation_level = 0;
   geometry::SparseMatrix L;  // limit points of the evaluation level from base control points
   SparseMatrix pattern;      // the normal equations' pattern (3V × 3V, values 0)
@@ -151,7 +156,8 @@ struct SurfaceRegistration::Impl {
   std::vector<BlockIndex> edge_blocks;  // per edge: (a,a), (b,b), (a,b), (b,a)
   std::vector<BlockIndex> diagonal;     // per vertex: (v,v)
 
-  Impl(const geometry::LoopHierarchy& h, const SurfaceRegistrationOptions& o) : hierarchy(h), options(o) {
+  Impl(const geometry::LoopHierarchy& h, const SurfaceRegistrationOptions& o, double edge)
+      : hierarchy(h), options(o), edge_length(edge) {
     options.Check();
     evaluation_level = std::min(1, hierarchy.finest_level());
     L = hierarchy.LimitPositions(evaluation_level);
@@ -230,8 +236,8 @@ struct SurfaceRegistration::Impl {
 };
 
 SurfaceRegistration::SurfaceRegistration(const geometry::LoopHierarchy& hierarchy,
-                                         const SurfaceRegistrationOptions& options)
-    : impl_(std::make_unique<const Impl>(hierarchy, options)) {}
+                                         const SurfaceRegistrationOptions& options, double edge_length)
+    : impl_(std::make_unique<const Impl>(hierarchy, options, edge_length)) {}
 
 SurfaceRegistration::~SurfaceRegistration() = default;
 
@@ -249,7 +255,9 @@ Positions SurfaceRegistration::Register(const Positions& base_control_points, co
 
   const SurfaceRegistrationOptions& options = impl.options;
   geometry::TriangleMesh limit_mesh{impl.L * base_control_points, hierarchy.LevelFaces(impl.evaluation_level)};
-  const double mean_edge = geometry::MeanEdgeLength(hierarchy.Topology(0), base_control_points);
+  const double mean_edge = impl.edge_length > 0.0
+                               ? impl.edge_length
+                               : geometry::MeanEdgeLength(hierarchy.Topology(0), base_control_points);
   const double max_distance = options.max_distance_edges * mean_edge;
   const TargetSample sample(target.mesh(), impl.L.rows());
 
@@ -260,7 +268,8 @@ Positions SurfaceRegistration::Register(const Positions& base_control_points, co
   const Distances before = Correspond(limit_mesh, target, sample, options, max_distance, nullptr);
   out.mean_surface_distance_before = before.surface;
   out.mean_target_distance_before = before.target;
-  const bool needed = before.target > options.min_start_distance_edges * mean_edge;
+  out.reachable_target_distance_before = before.reachable;
+  const bool needed = before.reachable > options.min_start_distance_edges * mean_edge;
   const int iterations = options.enabled && needed ? options.iterations : 0;
   Eigen::SimplicialLDLT<SparseMatrix> solver;
   if (iterations > 0) solver.analyzePattern(impl.pattern);
