@@ -165,17 +165,25 @@ struct SurfaceRegistration::Impl {
     const geometry::MeshTopology& topology = hierarchy.Topology(0);
     const int V = hierarchy.VertexCount(0);
 
-    Triplets triplets;
-    auto block = [&](int v, int w) {
-      for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) triplets.emplace_back(3 * v + r, 3 * w + c, 0.0);
-    };
+    // The pattern of the blocks (V × V) first, then each block's 9 entries: the pairs of
+    // L's rows repeat blocks many times over.
+    Triplets blocks;
     for (int i = 0; i < L.outerSize(); ++i)
       for (geometry::SparseMatrix::InnerIterator a(L, i); a; ++a)
-        for (geometry::SparseMatrix::InnerIterator b(L, i); b; ++b) block(a.col(), b.col());
-    for (int e = 0; e < topology.edge_count(); ++e)
-      block(topology.EdgeVertex(e, 0), topology.EdgeVertex(e, 1)), block(topology.EdgeVertex(e, 1), topology.EdgeVertex(e, 0));
-    for (int v = 0; v < V; ++v) block(v, v);
+        for (geometry::SparseMatrix::InnerIterator b(L, i); b; ++b) blocks.emplace_back(a.col(), b.col(), 0.0);
+    for (int e = 0; e < topology.edge_count(); ++e) {
+      blocks.emplace_back(topology.EdgeVertex(e, 0), topology.EdgeVertex(e, 1), 0.0);
+      blocks.emplace_back(topology.EdgeVertex(e, 1), topology.EdgeVertex(e, 0), 0.0);
+    }
+    for (int v = 0; v < V; ++v) blocks.emplace_back(v, v, 0.0);
+    SparseMatrix block_pattern(V, V);
+    block_pattern.setFromTriplets(blocks.begin(), blocks.end());
+    Triplets triplets;
+    triplets.reserve(9 * block_pattern.nonZeros());
+    for (int w = 0; w < block_pattern.outerSize(); ++w)
+      for (SparseMatrix::InnerIterator it(block_pattern, w); it; ++it)
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) triplets.emplace_back(3 * it.row() + r, 3 * w + c, 0.0);
     pattern.resize(3 * V, 3 * V);
     pattern.setFromTriplets(triplets.begin(), triplets.end());
     pattern.makeCompressed();
