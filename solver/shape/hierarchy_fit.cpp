@@ -1,5 +1,7 @@
 #include "solver/shape/hierarchy_fit.h"
 
+#include <string>
+
 #include "core/error.h"
 #include "geometry/local_frames.h"
 #include "solver/shape/surface_snapping.h"
@@ -11,6 +13,15 @@ using geometry::Positions;
 void HierarchyFitOptions::Check() const {
   if (iterations_per_level < 1)
     ThrowError("hierarchy fit options", "iterations_per_level", "expected ≥ 1");
+}
+
+void CheckBaseControlPoints(const geometry::LoopHierarchy& hierarchy, const Positions& base_control_points,
+                            const std::string& source) {
+  if (base_control_points.rows() != hierarchy.VertexCount(0))
+    ThrowError(source, "base control points",
+               "expected " + std::to_string(hierarchy.VertexCount(0)) + " rows, got " +
+                   std::to_string(base_control_points.rows()));
+  if (!base_control_points.allFinite()) ThrowError(source, "base control points", "expected finite coordinates");
 }
 
 namespace {
@@ -38,12 +49,7 @@ std::vector<Positions> FitHierarchyToSurface(const geometry::LoopHierarchy& hier
                                              const HierarchyFitOptions& options,
                                              std::vector<LevelFitSummary>* summaries) {
   options.Check();
-  if (base_control_points.rows() != hierarchy.VertexCount(0))
-    ThrowError("hierarchy fit", "base control points",
-               "expected " + std::to_string(hierarchy.VertexCount(0)) + " rows, got " +
-                   std::to_string(base_control_points.rows()));
-  if (!base_control_points.allFinite())
-    ThrowError("hierarchy fit", "base control points", "expected finite coordinates");
+  CheckBaseControlPoints(hierarchy, base_control_points, "hierarchy fit");
   const auto& V = target.mesh().V;
   const double diagonal = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
   const double max_distance =

@@ -7,6 +7,7 @@
 // moved along their limit normals onto the target, `iterations_per_level` times.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "geometry/closest_point.h"
@@ -32,6 +33,11 @@ struct LevelFitSummary {
   double mean_distance = 0.0;      // mean |limit point − target| after the level's steps
   double max_distance = 0.0;       // (closest-point distances, world units)
 };
+
+// Throws subflow::Error (naming `source`) unless `base_control_points` has one finite row
+// per vertex of level 0.
+void CheckBaseControlPoints(const geometry::LoopHierarchy& hierarchy, const geometry::Positions& base_control_points,
+                            const std::string& source);
 
 // Fits levels 0..n of `hierarchy` to `target` from `base_control_points` (#V(0)×3) and
 // returns the fitted control points of every level (element i is #V(i)×3). `summaries`

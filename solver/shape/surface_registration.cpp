@@ -13,6 +13,7 @@
 #include "core/stopwatch.h"
 #include "geometry/mean_edge_length.h"
 #include "geometry/vertex_normals.h"
+#include "solver/shape/hierarchy_fit.h"
 
 namespace subflow::solver {
 
@@ -63,11 +64,13 @@ void AddBlock(const BlockIndex& index, const Eigen::Matrix3d& block, double* val
     for (int r = 0; r < 3; ++r) values[index[c] + r] += block(r, c);
 }
 
-// Target vertices and their normals, every k-th so that there are about `wanted` of them
-// (the hull's vertices are denser than the registration needs).
+// What the iterations read of the (fixed) target: its face normals, and its vertices with
+// their normals, every k-th so that there are about `wanted` of them (the hull's vertices
+// are denser than the registration needs).
 struct TargetSample {
-  Positions points, normals;
-  TargetSample(const geometry::TriangleMesh& target, Eigen::Index wanted) {
+  Positions face_normals, points, normals;
+  TargetSample(const geometry::TriangleMesh& target, Eigen::Index wanted)
+      : face_normals(geometry::FaceNormals(target.V, target.F)) {
     const Positions all_normals = geometry::VertexNormals(target.V, target.F);
     const Eigen::Index stride = std::max<Eigen::Index>(1, (target.V.rows() + wanted - 1) / std::max<Eigen::Index>(1, wanted));
     const Eigen::Index count = (target.V.rows() + stride - 1) / stride;
@@ -103,21 +106,20 @@ Distances Correspond(const geometry::TriangleMesh& limit_mesh, const geometry::C
                      const TargetSample& sample, const SurfaceRegistrationOptions& options, double max_distance,
                      PointTerms* terms) {
   Distances distances;
-  const Positions limit_normals = geometry::VertexNormals(limit_mesh.V, limit_mesh.F);
-  const Positions target_face_normals = geometry::FaceNormals(target.mesh().V, target.mesh().F);
+  const Positions limit_normals = terms ? geometry::VertexNormals(limit_mesh.V, limit_mesh.F) : Positions();
   const std::vector<geometry::SurfacePoint> forward = target.ClosestPoints(limit_mesh.V);
   const double forward_weight = 1.0 / std::max<Eigen::Index>(1, limit_mesh.V.rows());
   for (Eigen::Index i = 0; i < limit_mesh.V.rows(); ++i) {
     const geometry::SurfacePoint& hit = forward[i];
     distances.surface += hit.distance * forward_weight;
     if (!terms || hit.face < 0 || hit.distance > max_distance) continue;
-    const Eigen::Vector3d n = target_face_normals.row(hit.face).transpose();
+    const Eigen::Vector3d n = sample.face_normals.row(hit.face).transpose();
     if (n.dot(limit_normals.row(i).transpose()) < options.min_normal_cosine) continue;
     terms->Add(i, hit.point, n, forward_weight, options.point_weight);
   }
 
   const geometry::ClosestPointTree surface(limit_mesh, "registered surface");
-  const Positions surface_normals = geometry::FaceNormals(limit_mesh.V, limit_mesh.F);
+  const Positions surface_normals = terms ? geometry::FaceNormals(limit_mesh.V, limit_mesh.F) : Positions();
   const std::vector<geometry::SurfacePoint> backward = surface.ClosestPoints(sample.points);
   int reachable = 0;
   const double backward_weight = 1.0 / std::max<Eigen::Index>(1, sample.points.rows());
@@ -148,8 +150,8 @@ struct SurfaceRegistration::Impl {
   int evaluation_level = 0;
   geometry::SparseMatrix L;  // limit points of the evaluation level from base control points
   SparseMatrix pattern;      // the normal equations' pattern (3V × 3V, values 0)
-  // Per limit point i, the blocks (v, w) over the pairs of its row of L: pairs[offset[i]
-  // + a·m + b] for its a-th and b-th entries (m entries).
+  // Per limit point i, the blocks (v, w) of the pairs of entries of its row of L, from
+  // pairs[offset[i]] on: (a, b) for a, then b, in the row's order.
   std::vector<int> offset;
   std::vector<BlockIndex> pairs;
   // Stiffness (per unit α) and damping, in the pattern's values; the edges' blocks.
@@ -212,14 +214,11 @@ struct SurfaceRegistration::Impl {
     *g = Eigen::VectorXd::Zero(pattern.rows());
     for (int i = 0; i < L.outerSize(); ++i) {
       if (terms.block[i].isZero(0.0)) continue;
-      int count = 0;  // entries of row i
-      for (geometry::SparseMatrix::InnerIterator it(L, i); it; ++it) ++count;
-      int a = 0;
-      for (geometry::SparseMatrix::InnerIterator ia(L, i); ia; ++ia, ++a) {
+      const BlockIndex* pair = pairs.data() + offset[i];  // in the order they were built
+      for (geometry::SparseMatrix::InnerIterator ia(L, i); ia; ++ia) {
         g->segment<3>(3 * ia.col()) += ia.value() * terms.rhs[i];
-        int b = 0;
-        for (geometry::SparseMatrix::InnerIterator ib(L, i); ib; ++ib, ++b)
-          AddBlock(pairs[offset[i] + a * count + b], (ia.value() * ib.value()) * terms.block[i], values);
+        for (geometry::SparseMatrix::InnerIterator ib(L, i); ib; ++ib)
+          AddBlock(*pair++, (ia.value() * ib.value()) * terms.block[i], values);
       }
     }
     const geometry::MeshTopology& topology = hierarchy.Topology(0);
@@ -254,12 +253,7 @@ Positions SurfaceRegistration::Register(const Positions& base_control_points, co
   const Stopwatch start;
   const Impl& impl = *impl_;
   const geometry::LoopHierarchy& hierarchy = impl.hierarchy;
-  if (base_control_points.rows() != hierarchy.VertexCount(0))
-    ThrowError("surface registration", "base control points",
-               "expected " + std::to_string(hierarchy.VertexCount(0)) + " rows, got " +
-                   std::to_string(base_control_points.rows()));
-  if (!base_control_points.allFinite())
-    ThrowError("surface registration", "base control points", "expected finite coordinates");
+  CheckBaseControlPoints(hierarchy, base_control_points, "surface registration");
 
   const SurfaceRegistrationOptions& options = impl.options;
   geometry::TriangleMesh limit_mesh{impl.L * base_control_points, hierarchy.LevelFaces(impl.evaluation_level)};
