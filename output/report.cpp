@@ -155,6 +155,8 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
                       {"hull_from_frame", frame.hull_from_frame},
                       {"voxel_resolution", frame.carving.resolution},
                       {"max_misses", frame.carving.max_misses},
+                      {"closing_radius", frame.carving.closing_radius},
+                      {"opening_radius", frame.carving.opening_radius},
                       {"carved_voxels", frame.carving.carved_voxels},
                       {"occupied_voxels", frame.carving.occupied_voxels},
                       {"components_found", frame.carving.components_found},

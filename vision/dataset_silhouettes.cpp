@@ -198,7 +198,8 @@ CarvingResult CarveFrame(const Dataset& dataset, int frame, const SilhouetteOpti
                          const VoxelCarvingOptions& carving_options) {
   carving_options.Check();
   const std::vector<Silhouette> silhouettes = ComputeSilhouettes(dataset, frame, silhouette_options);
-  return CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(), carving_options, frame);
+  return CarveVoxels(dataset.cameras(), silhouettes, dataset.bounds(),
+                     ResolveCarvingOptions(dataset.cameras(), dataset.bounds(), carving_options), frame);
 }
 
 }  // namespace subflow::vision

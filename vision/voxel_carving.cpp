@@ -167,20 +167,43 @@ void VoxelCarvingOptions::Check() const {
   if (threads < 0) fail("threads", "0 (all) or a positive count", threads);
 }
 
-int ChooseResolution(const std::vector<Camera>& cameras, const Bounds& bounds,
-                     const VoxelCarvingOptions& options) {
-  if (options.resolution > 0) return options.resolution;
+double AutomaticVoxelSpacing(const std::vector<Camera>& cameras, const Bounds& bounds,
+                             const VoxelCarvingOptions& options) {
   double finest = 0;  // pixels per world unit at the centre, best camera
+  const Eigen::Vector3d centre = bounds.Center();
   for (const Camera& camera : cameras) {
-    const Eigen::Vector3d centre = bounds.Center();
     if (!ProjectsIntoImage(camera, centre)) continue;
     const double focal = 0.5 * (camera.K()(0, 0) + camera.K()(1, 1));
     finest = std::max(finest, focal / camera.ToCamera(centre).z());
   }
-  if (finest <= 0) return options.max_auto_resolution;
-  const double spacing = options.pixels_per_voxel / finest;
+  return finest > 0 ? options.pixels_per_voxel / finest : 0.0;
+}
+
+int ChooseResolution(const std::vector<Camera>& cameras, const Bounds& bounds,
+                     const VoxelCarvingOptions& options) {
+  if (options.resolution > 0) return options.resolution;
+  const double spacing = AutomaticVoxelSpacing(cameras, bounds, options);
+  if (spacing <= 0) return options.max_auto_resolution;
   const double voxels = std::ceil(bounds.Size().maxCoeff() / spacing);
   return static_cast<int>(std::clamp(voxels, 8.0, static_cast<double>(options.max_auto_resolution)));
+}
+
+VoxelCarvingOptions ResolveCarvingOptions(const std::vector<Camera>& cameras, const Bounds& bounds,
+                                          const VoxelCarvingOptions& options) {
+  options.Check();
+  if (!bounds.IsValid()) ThrowError("", "bounds", "expected min < max (finite) on every axis");
+  VoxelCarvingOptions resolved = options;
+  resolved.resolution = ChooseResolution(cameras, bounds, options);
+  const double automatic = AutomaticVoxelSpacing(cameras, bounds, options);
+  const double spacing = bounds.Size().maxCoeff() / resolved.resolution;
+  if (automatic > 0 && spacing > automatic) {
+    const auto narrow = [&](int radius) {
+      return std::min(radius, static_cast<int>(std::floor(radius * automatic / spacing + 0.5)));
+    };
+    resolved.closing_radius = narrow(options.closing_radius);
+    resolved.opening_radius = narrow(options.opening_radius);
+  }
+  return resolved;
 }
 
 ScalarVolume MakeVoxelGrid(const Bounds& bounds, int resolution) {
@@ -254,6 +277,8 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
   bool any_motion = false;
   for (const CarvingCamera& c : used) any_motion = any_motion || silhouettes[c.index].source == EvidenceSource::kMotion;
   result.max_misses = options.max_misses >= 0 ? options.max_misses : (any_motion ? 1 : 0);
+  result.closing_radius = options.closing_radius;
+  result.opening_radius = options.opening_radius;
   result.resolution = ChooseResolution(cameras, bounds, options);
   result.occupancy = MakeVoxelGrid(bounds, result.resolution);
   ScalarVolume& occupancy = result.occupancy;

@@ -97,7 +97,8 @@ struct VoxelCarvingOptions {
   // Pixels added on each side of a footprint for the evidence mean (not for "sees"):
   // ½ covers the pixel-centre sampling of silhouettes.
   double footprint_margin = 0.5;
-  // Radius (voxels) of the closing, then of the opening (box (2r + 1)³); 0 = skip.
+  // Radius (voxels) of the closing, then of the opening (box (2r + 1)³); 0 = skip. These
+  // are the radii on the automatic grid; ResolveCarvingOptions narrows them on a coarser one.
   int closing_radius = 1;
   int opening_radius = 1;
   // Connectivity of occupied voxels for components (6 or 26); empty space uses the other.
@@ -137,6 +138,7 @@ struct CarvingResult {
   geometry::ScalarVolume occupancy;  // 0 / 1 per voxel, after cleaning
   int resolution = 0;                // voxels along the longest axis
   int max_misses = 0;                // the value used (after "automatic")
+  int closing_radius = 0, opening_radius = 0;  // the radii used (voxels)
   std::size_t carved_voxels = 0;     // occupied straight after carving
   std::size_t occupied_voxels = 0;   // occupied after cleaning
   int components_found = 0, components_kept = 0;
@@ -154,6 +156,29 @@ struct CarvingResult {
 // cap when no camera sees the centre.
 int ChooseResolution(const std::vector<Camera>& cameras, const Bounds& bounds,
                      const VoxelCarvingOptions& options);
+
+// The automatic grid's spacing before its cap: pixels_per_voxel / max_k (f_k / depth_k(centre))
+// as above; 0 when no camera sees the volume's centre.
+double AutomaticVoxelSpacing(const std::vector<Camera>& cameras, const Bounds& bounds,
+                             const VoxelCarvingOptions& options);
+
+// The options with which the images of `cameras` (the STORED images, before any reduction
+// for the evidence) are carved: the resolution fixed (ChooseResolution), and the closing and
+// opening radii narrowed where that grid is coarser than the automatic one (the cap over a
+// large volume, or a coarse `resolution`):
+//     r ← min(r, ⌊r · s_auto / s + ½⌋),   s_auto = AutomaticVoxelSpacing, s = the grid's spacing,
+// so that the morphology's box never spans more image pixels than on the automatic grid.
+// Why: the closing and the opening clean what silhouette noise leaves in the carving —
+// specks, pinholes, slivers a few pixels wide — and their box is sized for voxels of
+// pixels_per_voxel pixels. On a coarser grid a voxel's footprint already averages many
+// pixels (a speck must cover evidence_threshold of it to count), and the same box spans
+// parts of the subject instead: on the pose2sim take (a room-sized volume, the 160-voxel
+// cap, voxels of 2.7 cm spanning ~11 pixels of the stored images) the 3-voxel opening
+// removed shins, feet and forearms — the 4–8 cm parts of a person — in every frame.
+// Radii are unchanged on the automatic grid and on finer ones, and when no camera sees
+// the volume's centre.
+VoxelCarvingOptions ResolveCarvingOptions(const std::vector<Camera>& cameras, const Bounds& bounds,
+                                          const VoxelCarvingOptions& options);
 
 // An empty grid of cubic voxels of edge L / resolution (L = the longest side of
 // `bounds`), ceil(size / spacing) voxels per axis, centred on the bounds.

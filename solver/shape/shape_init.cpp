@@ -303,9 +303,10 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   if (!store) store = &in_frames;
 
   // Evidence on images reduced to what the voxel grid resolves (vision/working_scale.h),
-  // the grid's resolution fixed first so that it does not follow the reduced cameras.
-  vision::VoxelCarvingOptions carving = options.carving;
-  carving.resolution = vision::ChooseResolution(dataset.cameras(), dataset.bounds(), options.carving);
+  // the grid's resolution and morphology fixed first on the stored images, so that they do
+  // not follow the reduced cameras.
+  const vision::VoxelCarvingOptions carving =
+      vision::ResolveCarvingOptions(dataset.cameras(), dataset.bounds(), options.carving);
   const double voxel_size = dataset.bounds().Size().maxCoeff() / carving.resolution;
   result.evidence_scales.resize(dataset.camera_count());
   for (int k = 0; k < dataset.camera_count(); ++k)
@@ -314,8 +315,9 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   const std::vector<vision::Camera> evidence_cameras = vision::ScaledCameras(dataset.cameras(), result.evidence_scales);
   std::string scales;
   for (double scale : result.evidence_scales) scales += fmt::format("{}{:.3f}", scales.empty() ? "" : " ", scale);
-  spdlog::info("evidence images at {} of the stored size (voxels of {:.4g}, {} along the longest axis)", scales,
-               voxel_size, carving.resolution);
+  spdlog::info("evidence images at {} of the stored size (voxels of {:.4g}, {} along the longest axis; closing "
+               "and opening radii {} and {})",
+               scales, voxel_size, carving.resolution, carving.closing_radius, carving.opening_radius);
 
   // Without masks and background images: backgrounds estimated from the video.
   Stopwatch estimate_start;
