@@ -136,7 +136,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalFlowSolverOptions, smoothn
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MotionStepOptions, sampling, visibility, solver, image_sigmas)
 // WITH_DEFAULT below too.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,
-                                                hull_iterations, guess_from_targets, concurrent_chains)
+                                                hull_iterations, registration, guess_from_targets,
+                                                concurrent_chains)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WindowSolverOptions, linear_solver, max_iterations, threads,
                                                 function_tolerance, iterative_from_unknowns, iterative_solver,
                                                 iterative_eta, reduced_correlation_blocks)

@@ -216,6 +216,7 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
                       {"correction_rms_before", f.correction_rms_before},
                       {"correction_rms_applied", f.correction_rms_applied},
                       {"seconds", f.step.seconds}});
+    if (f.corrected && o.registration.enabled) frames.back()["registration"] = RegistrationJson(f.registration);
     if (o.guess_from_targets && f.from_frame >= 0)
       frames.back()["guess"] = {{"used", f.step.guess_used},
                                 {"photometric_rms", f.step.guess_rms},

@@ -13,6 +13,7 @@
 #include "core/stopwatch.h"
 #include "geometry/closest_point.h"
 #include "geometry/mean_edge_length.h"
+#include "geometry/multires_shape.h"
 #include "solver/shape/surface_snapping.h"
 
 namespace subflow::solver {
@@ -53,6 +54,7 @@ void MotionInitOptions::Check() const {
     ThrowError("motion init", "hull_max_distance", "expected a finite value ≥ 0 (0 = automatic)");
   if (hull_iterations < 1 || hull_iterations > 20)
     ThrowError("motion init", "hull_iterations", "expected 1..20");
+  registration.Check();
 }
 
 namespace {
@@ -111,6 +113,11 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
                                     ? options.hull_max_distance
                                     : 3.0 * geometry::MeanEdgeLength(hierarchy.Topology(n), reference);
 
+  // Distances of the registration's gate in the reference frame's base edges.
+  const geometry::MultiresShape reference_shape = geometry::MultiresShape::Analyze(hierarchy, reference);
+  const SurfaceRegistration registration(
+      hierarchy, options.registration, geometry::MeanEdgeLength(hierarchy.Topology(0), reference_shape.base()));
+
   MotionInitResult result;
   result.reference_frame = reference_frame;
   result.control.assign(frame_count, Positions());
@@ -146,6 +153,14 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     if (target && options.hull_weight > 0.0) {
       const geometry::ClosestPointTree tree(estimator.visibility().Tessellation(*target),
                                             "fitted surface of frame " + std::to_string(to));
+      if (options.registration.enabled) {
+        geometry::MultiresShape shape = geometry::MultiresShape::Analyze(hierarchy, control);
+        Positions registered = registration.Register(shape.base(), tree, &report.registration);
+        if (report.registration.applied) {
+          shape.base() = std::move(registered);
+          control = shape.Synthesize(hierarchy, n);
+        }
+      }
       SurfaceSnapOptions snap;
       snap.weight = options.hull_weight;
       snap.max_distance = max_correction;

@@ -9,7 +9,13 @@
 //   initialization on its visual hull), the normal component is corrected towards their
 //   limit surface (SnapToSurface, blend `hull_weight`, |distance| ≤ hull_max_distance):
 //   the hull bounds the drift along the normals; the tangential correspondence comes from
-//   the image motion alone.
+//   the image motion alone. Before that snap, a surface that drifted from the frame's fit
+//   by more than the registration's gate (a quarter base edge, on average over the fit
+//   within reach) is registered to it (solver/shape/surface_registration.h, on the base
+//   control points of the step's multi-resolution analysis; the details ride along in
+//   their local frames): over a long chain the image motion of a fast, thin part (a
+//   kicking leg, 44 frames from pose2sim's reference) slides it off its place, sideways,
+//   where a snap along the normals cannot bring it back.
 // Every frame keeps the hierarchy's connectivity: no re-meshing over time.
 //
 // The rigid / non-rigid split of the trajectories is a stage of its own
@@ -23,6 +29,7 @@
 #include "geometry/loop_hierarchy.h"
 #include "geometry/triangle_mesh.h"
 #include "solver/motion/motion_step.h"
+#include "solver/shape/surface_registration.h"
 #include "vision/image_sequence.h"
 
 namespace subflow::solver {
@@ -35,6 +42,9 @@ struct MotionInitOptions {
   double hull_weight = 0.5;
   double hull_max_distance = 0.0;
   int hull_iterations = 2;
+  // Registration to each frame's fitted surface before the snap (see above); its gate
+  // leaves a surface that follows its fit alone.
+  SurfaceRegistrationOptions registration;
   // Start each step's first pass at the displacement from the current control points to
   // the target frame's own surface (when it has one) instead of at zero: for the retrack
   // pass, whose targets are the refined shapes — one connectivity whose vertices already
@@ -55,6 +65,7 @@ struct MotionFrameReport {
   bool corrected = false;           // normal correction applied
   double correction_rms_before = 0.0;   // RMS normal distance to the frame's fitted surface
   double correction_rms_applied = 0.0;  // RMS length of the correction applied to the control points
+  SurfaceRegistrationReport registration;  // measured whenever corrected; `applied` when registered
 };
 
 struct MotionInitResult {
