@@ -92,6 +92,32 @@ bool CheckMotionInputs(const vision::ImageSequence& images, const geometry::Loop
 
 }  // namespace
 
+Positions CorrectTowardsFit(const geometry::LoopHierarchy& hierarchy, const SurfaceRegistration& registration,
+                            const Positions& control, const geometry::ClosestPointTree& fit,
+                            const MotionInitOptions& options, double max_correction, MotionFrameReport* report) {
+  const int n = hierarchy.finest_level();
+  Positions corrected = control;
+  if (options.registration.enabled) {
+    geometry::MultiresShape shape = geometry::MultiresShape::Analyze(hierarchy, control);
+    Positions registered = registration.Register(shape.base(), fit, &report->registration);
+    if (report->registration.applied) {
+      shape.base() = std::move(registered);
+      corrected = shape.Synthesize(hierarchy, n);
+    }
+  }
+  SurfaceSnapOptions snap;
+  snap.weight = options.hull_weight;
+  snap.max_distance = max_correction;
+  snap.iterations = options.hull_iterations;
+  snap.measure_after = false;
+  SurfaceSnapReport snap_report;
+  corrected = SnapToSurface(hierarchy, n, corrected, fit, snap, &snap_report);
+  report->corrected = true;
+  report->correction_rms_before = snap_report.rms_distance_before;
+  report->correction_rms_applied = snap_report.rms_correction;
+  return corrected;
+}
+
 MotionInitResult InitializeMotion(const vision::ImageSequence& images,
                                   const geometry::LoopHierarchy& hierarchy,
                                   const std::vector<Positions>& initial_control,
@@ -153,24 +179,7 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     if (target && options.hull_weight > 0.0) {
       const geometry::ClosestPointTree tree(estimator.visibility().Tessellation(*target),
                                             "fitted surface of frame " + std::to_string(to));
-      if (options.registration.enabled) {
-        geometry::MultiresShape shape = geometry::MultiresShape::Analyze(hierarchy, control);
-        Positions registered = registration.Register(shape.base(), tree, &report.registration);
-        if (report.registration.applied) {
-          shape.base() = std::move(registered);
-          control = shape.Synthesize(hierarchy, n);
-        }
-      }
-      SurfaceSnapOptions snap;
-      snap.weight = options.hull_weight;
-      snap.max_distance = max_correction;
-      snap.iterations = options.hull_iterations;
-      snap.measure_after = false;
-      SurfaceSnapReport snap_report;
-      control = SnapToSurface(hierarchy, n, control, tree, snap, &snap_report);
-      report.corrected = true;
-      report.correction_rms_before = snap_report.rms_distance_before;
-      report.correction_rms_applied = snap_report.rms_correction;
+      control = CorrectTowardsFit(hierarchy, registration, control, tree, options, max_correction, &report);
     }
     result.control[to] = std::move(control);
     spdlog::debug("motion init: frame {} -> {}: {} constraints, {} pruned, photometric rms {:.4f} "

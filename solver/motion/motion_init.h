@@ -9,8 +9,8 @@
 //   initialization on its visual hull), the normal component is corrected towards their
 //   limit surface (SnapToSurface, blend `hull_weight`, |distance| ≤ hull_max_distance):
 //   the hull bounds the drift along the normals; the tangential correspondence comes from
-//   the image motion alone. Before that snap, a surface that drifted from the frame's fit
-//   by more than the registration's gate (a quarter base edge, on average over the fit
+//   the image motion alone. Optionally (registration.enabled), before that snap, a surface
+//   that drifted from the frame's fit by more than the registration's gate (a quarter base edge, on average over the fit
 //   within reach) is registered to it (solver/shape/surface_registration.h, on the base
 //   control points of the step's multi-resolution analysis; the details ride along in
 //   their local frames): over a long chain the image motion of a fast, thin part (a
@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "core/progress.h"
+#include "geometry/closest_point.h"
 #include "geometry/loop_hierarchy.h"
 #include "geometry/triangle_mesh.h"
 #include "solver/motion/motion_step.h"
@@ -43,8 +44,16 @@ struct MotionInitOptions {
   double hull_max_distance = 0.0;
   int hull_iterations = 2;
   // Registration to each frame's fitted surface before the snap (see above); its gate
-  // leaves a surface that follows its fit alone.
-  SurfaceRegistrationOptions registration;
+  // leaves a surface that follows its fit alone. Off by default: on pose2sim_multiperson it
+  // registered 54 of 99 steps for +54 s (+20 %) of the motion stage, covered one more shin
+  // at frame 6 in one camera and changed nothing visible at frame 90, while the snap's RMS
+  // distance to the fits rose (median 11.8 → 13.9 mm); the synthetic scenes and the blob
+  // never trip its gate (docs/shape.md, 2026-12-05).
+  SurfaceRegistrationOptions registration = [] {
+    SurfaceRegistrationOptions off;
+    off.enabled = false;
+    return off;
+  }();
   // Start each step's first pass at the displacement from the current control points to
   // the target frame's own surface (when it has one) instead of at zero: for the retrack
   // pass, whose targets are the refined shapes — one connectivity whose vertices already
@@ -77,6 +86,17 @@ struct MotionInitResult {
   // One line: frames, reference, photometric RMS of zero motion → estimated, seconds.
   std::string BriefReport() const;
 };
+
+// One step's correction towards its frame's fitted surface `fit` (see the file comment):
+// the registration (`registration` built with options.registration, its gate deciding),
+// then the snap along the normals (hull_weight, |correction| ≤ max_correction,
+// hull_iterations). Fills report->corrected, correction_rms_before/applied and
+// registration. Returns the corrected finest control points.
+geometry::Positions CorrectTowardsFit(const geometry::LoopHierarchy& hierarchy,
+                                      const SurfaceRegistration& registration,
+                                      const geometry::Positions& control, const geometry::ClosestPointTree& fit,
+                                      const MotionInitOptions& options, double max_correction,
+                                      MotionFrameReport* report);
 
 // Trajectories for the frames of `images` (its gray images; frames and reference_frame
 // are window frames). `initial_control`: either one matrix (the reference frame's fitted
