@@ -9,10 +9,10 @@
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
-#include <opencv2/calib3d.hpp>
 
 #include "core/error.h"
 #include "geometry/mesh_io.h"
+#include "tests/vision/carving_test_rig.h"
 #include "vision/dataset.h"
 
 namespace subflow::vision {
@@ -20,55 +20,7 @@ namespace {
 
 using geometry::ScalarVolume;
 
-// A camera at `centre` looking at `target`, world +z up (x = z × up, y = z × x).
-Camera LookAt(const std::string& name, int width, int height, double focal,
-              const Eigen::Vector3d& centre, const Eigen::Vector3d& target,
-              const Eigen::VectorXd& distortion = Eigen::VectorXd()) {
-  const Eigen::Vector3d z = (target - centre).normalized();
-  const Eigen::Vector3d up = std::abs(z.z()) > 0.99 ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d x = z.cross(up).normalized();
-  Eigen::Matrix3d R;
-  R.row(0) = x;
-  R.row(1) = z.cross(x);
-  R.row(2) = z;
-  Eigen::Matrix3d K;
-  K << focal, 0, 0.5 * (width - 1), 0, focal, 0.5 * (height - 1), 0, 0, 1;
-  return Camera(name, width, height, K, R, -R * centre, distortion);
-}
-
-Eigen::Vector3d Spherical(double distance, double azimuth_deg, double elevation_deg) {
-  const double a = azimuth_deg * M_PI / 180, e = elevation_deg * M_PI / 180;
-  return distance * Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
-}
-
-struct Sphere {
-  Eigen::Vector3d centre{0.01, -0.015, 0.02};
-  double radius = 0.08;
-};
-
-// Exact silhouette of the sphere in the RAW image: pixel centres whose ray meets the
-// sphere. Rays of distorted pixels come from OpenCV's cv::undistortPoints (iterated to
-// 1e-12), independently of Camera's own distortion code.
-cv::Mat SphereMask(const Camera& camera, const Sphere& sphere) {
-  std::vector<cv::Point2d> pixels, normalized;
-  for (int y = 0; y < camera.height(); ++y)
-    for (int x = 0; x < camera.width(); ++x) pixels.emplace_back(x, y);
-  cv::Mat K(3, 3, CV_64F), d(1, 5, CV_64F);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = camera.K()(r, c);
-  for (int i = 0; i < 5; ++i) d.at<double>(0, i) = camera.distortion()[i];
-  cv::undistortPoints(pixels, normalized, K, d, cv::noArray(), cv::noArray(),
-                      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
-  cv::Mat mask = cv::Mat::zeros(camera.height(), camera.width(), CV_8UC1);
-  const Eigen::Vector3d to_centre = sphere.centre - camera.Center();
-  for (size_t p = 0; p < pixels.size(); ++p) {
-    const Eigen::Vector3d d_world =
-        (camera.R().transpose() * Eigen::Vector3d(normalized[p].x, normalized[p].y, 1.0)).normalized();
-    if (to_centre.dot(d_world) > 0 && (to_centre - to_centre.dot(d_world) * d_world).norm() <= sphere.radius)
-      mask.at<uint8_t>(static_cast<int>(pixels[p].y), static_cast<int>(pixels[p].x)) = 255;
-  }
-  return mask;
-}
+using namespace carving_rig;
 
 // Distance from X to the silhouette cone of the sphere seen from camera centre C
 // (0 inside the cone): |X − C| sin(β − α), β = angle of X off the axis, α = half-angle.
@@ -79,39 +31,10 @@ double DistanceToCone(const Eigen::Vector3d& X, const Eigen::Vector3d& C, const 
   return beta <= alpha ? 0.0 : v.norm() * std::sin(std::min(beta - alpha, M_PI / 2));
 }
 
-// Six cameras at 0.6 m around the origin: a ring of four at 15° elevation, one from high
-// above, one from below; 160 × 120 pixels, f = 200 px (≈ 333 px/m at the centre).
-std::vector<Camera> SixCameras(const Eigen::VectorXd& distortion = Eigen::VectorXd()) {
-  std::vector<Camera> cameras;
-  const double directions[6][2] = {{20, 15}, {110, 15}, {200, 15}, {290, 15}, {60, 70}, {245, -50}};
-  for (int c = 0; c < 6; ++c)
-    cameras.push_back(LookAt("cam" + std::to_string(c), 160, 120, 200,
-                             Spherical(0.6, directions[c][0], directions[c][1]),
-                             Eigen::Vector3d::Zero(), distortion));
-  return cameras;
-}
-
 std::vector<Silhouette> SphereSilhouettes(const std::vector<Camera>& cameras, const Sphere& sphere) {
   std::vector<Silhouette> silhouettes;
   for (const Camera& camera : cameras) silhouettes.push_back(SilhouetteFromMask(SphereMask(camera, sphere)));
   return silhouettes;
-}
-
-const Bounds kBounds{Eigen::Vector3d::Constant(-0.15), Eigen::Vector3d::Constant(0.15)};
-
-// Occupancy at X by trilinear interpolation of the voxel centres' values (0 outside the
-// grid): ≥ 0.5 means X is inside the iso-surface at 0.5 that the mesher extracts.
-double TrilinearOccupancy(const ScalarVolume& volume, const Eigen::Vector3d& X) {
-  const Eigen::Vector3d g = (X - volume.origin) / volume.spacing;
-  const Eigen::Vector3d f = g.array().floor();
-  double value = 0;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3i c = f.cast<int>() + Eigen::Vector3i(corner & 1, (corner >> 1) & 1, corner >> 2);
-    if (!volume.InRange(c.x(), c.y(), c.z())) continue;
-    const Eigen::Vector3d w = (Eigen::Vector3d::Ones() - (g - c.cast<double>()).cwiseAbs());
-    value += w.prod() * volume.at(c.x(), c.y(), c.z());
-  }
-  return value;
 }
 
 // The claims about a carved sphere: (1) conservative — every voxel whose centre lies in
@@ -369,91 +292,6 @@ TEST(VoxelCarving, ObjectLeavingTheBoundsIsReportedWithFrameAndSide) {
   ASSERT_EQ(result.warnings.size(), 1u);
   EXPECT_NE(result.warnings[0].find("frame 5: the object touches the +x side"), std::string::npos)
       << result.warnings[0];
-}
-
-// ---- the morphology on grids coarser than the automatic one (ResolveCarvingOptions) ----
-
-// Mask of a sphere with a thin rod (a capsule from `a` to `b` of radius `rod`) sticking out
-// of it: pixel centres whose ray passes the rod's axis within `rod` (the axis sampled every
-// 0.2 mm) or meets the sphere.
-cv::Mat SphereWithRodMask(const Camera& camera, const Sphere& sphere, const Eigen::Vector3d& a,
-                          const Eigen::Vector3d& b, double rod) {
-  cv::Mat mask = SphereMask(camera, sphere);
-  const int samples = static_cast<int>(std::ceil((b - a).norm() / 2e-4));
-  for (int y = 0; y < camera.height(); ++y)
-    for (int x = 0; x < camera.width(); ++x) {
-      const Eigen::Vector3d d = camera.BackProject(Eigen::Vector2d(x, y)).normalized();
-      for (int s = 0; s <= samples; ++s) {
-        const Eigen::Vector3d v = a + (b - a) * (double(s) / samples) - camera.Center();
-        if ((v - v.dot(d) * d).norm() <= rod) {
-          mask.at<uint8_t>(y, x) = 255;
-          break;
-        }
-      }
-    }
-  return mask;
-}
-
-TEST(VoxelCarving, MorphologyIsNarrowedOnlyOnGridsCoarserThanTheAutomaticOne) {
-  const std::vector<Camera> cameras = SixCameras();
-  VoxelCarvingOptions options;  // automatic: 2 px per voxel at ≈ 333 px/m → 6 mm, 50 voxels
-  const double automatic = AutomaticVoxelSpacing(cameras, kBounds, options);
-  EXPECT_NEAR(automatic, 2.0 / (200.0 / 0.6), 1e-3 * automatic);
-  const VoxelCarvingOptions on_automatic = ResolveCarvingOptions(cameras, kBounds, options);
-  EXPECT_EQ(on_automatic.resolution, ChooseResolution(cameras, kBounds, options));
-  EXPECT_EQ(on_automatic.closing_radius, 1);
-  EXPECT_EQ(on_automatic.opening_radius, 1);
-  options.resolution = 100;  // finer: unchanged
-  EXPECT_EQ(ResolveCarvingOptions(cameras, kBounds, options).opening_radius, 1);
-  options.resolution = 30;  // 1.7× coarser: a 3-voxel box spans 10 px instead of 6; ⌊0.6 + ½⌋ = 1
-  EXPECT_EQ(ResolveCarvingOptions(cameras, kBounds, options).opening_radius, 1);
-  options.resolution = 20;  // 2.5× coarser: ⌊0.4 + ½⌋ = 0
-  EXPECT_EQ(ResolveCarvingOptions(cameras, kBounds, options).closing_radius, 0);
-  EXPECT_EQ(ResolveCarvingOptions(cameras, kBounds, options).opening_radius, 0);
-  options.resolution = 12;
-  options.closing_radius = options.opening_radius = 3;  // ⌊3 · 0.24 + ½⌋ = 1
-  EXPECT_EQ(ResolveCarvingOptions(cameras, kBounds, options).opening_radius, 1);
-  // No camera sees the volume's centre: nothing to measure the grid against, unchanged.
-  const Bounds away{Eigen::Vector3d(-0.15, -0.15, 4.85), Eigen::Vector3d(0.15, 0.15, 5.15)};  // above every view
-  EXPECT_EQ(AutomaticVoxelSpacing(cameras, away, options), 0.0);
-  EXPECT_EQ(ResolveCarvingOptions(cameras, away, options).opening_radius, 3);
-}
-
-// A rod 16 mm thick sticking out of a sphere, carved on a grid of 25 mm voxels (4× coarser
-// than the automatic 6 mm, as the 160-voxel cap makes a room-sized volume): the rod is
-// about two voxels across, so an opening by a 3-voxel box removes it; the resolved options
-// keep it (every voxel on its axis is occupied) and keep the sphere.
-TEST(VoxelCarving, ThinPartOnACoarseGridSurvivesTheResolvedMorphology) {
-  const std::vector<Camera> cameras = SixCameras();
-  Sphere sphere;
-  sphere.centre = Eigen::Vector3d(-0.04, 0, 0);
-  sphere.radius = 0.06;
-  const Eigen::Vector3d a(0.0, 0.0, 0.0), b(0.13, 0.0, 0.0);
-  std::vector<Silhouette> silhouettes;
-  for (const Camera& camera : cameras)
-    silhouettes.push_back(SilhouetteFromMask(SphereWithRodMask(camera, sphere, a, b, 0.008)));
-  VoxelCarvingOptions options;
-  options.resolution = 12;
-  options.compute_silhouette_iou = false;
-  const VoxelCarvingOptions resolved = ResolveCarvingOptions(cameras, kBounds, options);
-  ASSERT_EQ(resolved.opening_radius, 0);
-  const auto rod_voxels_occupied = [&](const CarvingResult& result) {
-    int occupied = 0, total = 0;
-    for (double x = 0.03; x <= 0.12; x += 0.01, ++total) occupied += TrilinearOccupancy(result.occupancy, {x, 0, 0}) >= 0.5;
-    return std::make_pair(occupied, total);
-  };
-  const CarvingResult kept = CarveVoxels(cameras, silhouettes, kBounds, resolved);
-  const auto [kept_on_axis, axis_points] = rod_voxels_occupied(kept);
-  EXPECT_EQ(kept_on_axis, axis_points) << "points of the rod's axis outside the hull carved with the resolved options";
-  EXPECT_GE(TrilinearOccupancy(kept.occupancy, sphere.centre), 0.5);
-  EXPECT_EQ(kept.opening_radius, 0);
-  // The same grid with the box sized for the automatic grid: the rod is gone.
-  const CarvingResult opened = CarveVoxels(cameras, silhouettes, kBounds, options);
-  const auto [opened_on_axis, unused] = rod_voxels_occupied(opened);
-  EXPECT_LE(opened_on_axis, 2) << "the 3-voxel opening was expected to remove the 2-voxel rod";
-  EXPECT_EQ(opened.opening_radius, 1);
-  std::printf("[ figures ] rod axis points occupied: %d of %d with the resolved morphology, %d with radius 1\n",
-              kept_on_axis, axis_points, opened_on_axis);
 }
 
 TEST(VoxelCarving, OptionsAreChecked) {
