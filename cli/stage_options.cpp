@@ -148,6 +148,9 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
   sub->add_option("--window-overlap", o->window_overlap,
                   "Frames a window shares with the next one, solved again there (at most --window - 1)")
       ->capture_default_str();
+  sub->add_flag("--concurrent-halves", o->concurrent_halves,
+               "Refine a take of at least 3 windows as two halves side by side, then a window across the seam "
+               "(faster on large windows, more memory; see docs/speed.md)");
   sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
   sub->add_option("--iterations", o->solver.max_iterations, "Ceres iterations per window and round")
       ->capture_default_str();

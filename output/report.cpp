@@ -195,7 +195,7 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
           {"still", still},
           {"frames", frames},
           {"seconds", {{"carve", carve}, {"isosurface", isosurface}, {"simplify", result.simplify_seconds},
-                       {"fit", fit}}}};
+                       {"fit", fit}, {"total", result.seconds}}}};
 }
 
 nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::MotionInitResult& result,

@@ -2,11 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <string>
 #include <vector>
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
+#include <tbb/parallel_invoke.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include "core/stopwatch.h"
 #include "geometry/closest_point.h"
@@ -101,44 +105,83 @@ struct HullStage {
   const std::vector<vision::Silhouette>* standing = nullptr;
   int reference_frame = -1;  // the only frame whose concavities are carved unless every_frame
 
+  // Frames go through three steps: evidence and carving (in frame order: video decoders
+  // read forwards), the iso-surface (CGAL Mesh_3, one thread: frames side by side), and
+  // storing the hull (in frame order). A frame's result does not depend on the others.
   void Run(const vision::SilhouetteOptions& silhouette_options, const std::vector<vision::Silhouette>* still,
            Progress* progress, std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
            std::vector<bool>* all_empty, ShapeFrameStore* store) const {
     const int count = static_cast<int>(frames->size());
+    std::vector<geometry::TriangleMesh> hulls(count);  // between extraction and the store
+    int next = 0;
     ProgressBegin(progress, "visual hull", count);
-    for (int i = 0; i < count; ++i) {
-      FrameShapeInit& frame = (*frames)[i];
-      Stopwatch start;
-      std::vector<vision::Silhouette> silhouettes;
-      if (still) {
-        silhouettes = *still;
-      } else {
-        silhouettes = vision::ComputeFrameEvidence(dataset, frame.frame, silhouette_options, &estimated, &cameras);
-        if (standing) vision::AddStandingEvidence(*standing, &silhouettes);
-      }
-      (*has_evidence)[i] = !vision::LacksEvidence(silhouettes, carving.min_cameras);
-      // Empty masks or background differences say the object is absent (motion evidence
-      // only that nothing moves).
-      (*all_empty)[i] = std::all_of(silhouettes.begin(), silhouettes.end(), [](const vision::Silhouette& s) {
-        return s.empty && s.source != vision::EvidenceSource::kMotion;
-      });
-      if ((*has_evidence)[i]) {
-        frame.carving = vision::CarveVoxels(cameras, silhouettes, dataset.bounds(), carving, frame.frame);
-        if (concavities.enabled && (concavities.every_frame || frame.frame == reference_frame))
-          CarveFrameConcavities(&frame);
-        frame.carve_seconds = start.Seconds();
-        start.Restart();
-        const geometry::TriangleMesh hull = geometry::ExtractIsosurface(
-            frame.carving.occupancy, isosurface, &frame.isosurface, "occupancy of frame " + vision::FrameName(frame.frame));
-        frame.isosurface_seconds = start.Seconds();
-        frame.hull_vertices = hull.vertex_count();
-        frame.hull_faces = hull.face_count();
-        store->StoreHull(frame.frame, hull);
-        frame.carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
-      }
-      ProgressUpdate(progress, i + 1);
-    }
+    // A frame and whether it was carved (has_evidence's bits are shared: only the first
+    // step writes or reads them).
+    struct Token {  // trivial: TBB passes it by value between the steps
+      int i;
+      bool carved;
+    };
+    tbb::parallel_pipeline(
+        static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()) + 1,
+        tbb::make_filter<void, Token>(tbb::filter_mode::serial_in_order,
+                                      [&](tbb::flow_control& control) {
+                                        if (next == count) {
+                                          control.stop();
+                                          return Token{-1, false};
+                                        }
+                                        Carve(silhouette_options, still, next, frames, has_evidence, all_empty);
+                                        const Token token{next, (*has_evidence)[next]};
+                                        ++next;
+                                        return token;
+                                      }) &
+            tbb::make_filter<Token, Token>(tbb::filter_mode::parallel,
+                                           [&](Token token) {
+                                             if (token.carved) ExtractHull(&(*frames)[token.i], &hulls[token.i]);
+                                             return token;
+                                           }) &
+            tbb::make_filter<Token, void>(tbb::filter_mode::serial_in_order, [&](Token token) {
+              if (token.carved) store->StoreHull((*frames)[token.i].frame, hulls[token.i]);
+              hulls[token.i] = geometry::TriangleMesh();
+              ProgressUpdate(progress, token.i + 1);
+            }));
     ProgressEnd(progress);
+  }
+
+  // Frame i's evidence, has_evidence / all_empty, and its carving when it has evidence.
+  void Carve(const vision::SilhouetteOptions& silhouette_options, const std::vector<vision::Silhouette>* still,
+             int i, std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
+             std::vector<bool>* all_empty) const {
+    FrameShapeInit& frame = (*frames)[i];
+    const Stopwatch start;
+    std::vector<vision::Silhouette> silhouettes;
+    if (still) {
+      silhouettes = *still;
+    } else {
+      silhouettes = vision::ComputeFrameEvidence(dataset, frame.frame, silhouette_options, &estimated, &cameras);
+      if (standing) vision::AddStandingEvidence(*standing, &silhouettes);
+    }
+    (*has_evidence)[i] = !vision::LacksEvidence(silhouettes, carving.min_cameras);
+    // Empty masks or background differences say the object is absent (motion evidence
+    // only that nothing moves).
+    (*all_empty)[i] = std::all_of(silhouettes.begin(), silhouettes.end(), [](const vision::Silhouette& s) {
+      return s.empty && s.source != vision::EvidenceSource::kMotion;
+    });
+    if (!(*has_evidence)[i]) return;
+    frame.carving = vision::CarveVoxels(cameras, silhouettes, dataset.bounds(), carving, frame.frame);
+    if (concavities.enabled && (concavities.every_frame || frame.frame == reference_frame))
+      CarveFrameConcavities(&frame);
+    frame.carve_seconds = start.Seconds();
+  }
+
+  // The frame's hull from its carving (whose occupancy is then released).
+  void ExtractHull(FrameShapeInit* frame, geometry::TriangleMesh* hull) const {
+    const Stopwatch start;
+    *hull = geometry::ExtractIsosurface(frame->carving.occupancy, isosurface, &frame->isosurface,
+                                        "occupancy of frame " + vision::FrameName(frame->frame));
+    frame->isosurface_seconds = start.Seconds();
+    frame->hull_vertices = hull->vertex_count();
+    frame->hull_faces = hull->face_count();
+    frame->carving.occupancy = geometry::ScalarVolume();  // memory: keep the figures only
   }
 
   // The frame's hull carved where its images see through it (vision/concavity_carving.h).
@@ -195,65 +238,65 @@ std::vector<vision::Silhouette> StillSilhouettes(const vision::Dataset& dataset,
 // Fits the hierarchy to every frame's hull (FrameShapeInit::fit and fit_seconds; the
 // control points of levels 0..n to `store`), outwards from the reference frame. A frame
 // starts from its neighbour's fitted base, the frame fitted last on its side of the
-// reference frame: only those two bases are kept. Returns the reference frame's finest
-// control points.
+// reference frame. The two sides share only the reference frame's base: they run side by
+// side (each frame's fit is what it would be alone), the store's calls one at a time.
+// Returns the reference frame's finest control points.
 geometry::Positions FitEveryFrame(const ShapeInitOptions& options, ShapeFrameStore* store, Progress* progress,
                                   ShapeInitResult* result) {
   const int count = static_cast<int>(result->frames.size());
   const int reference_index = result->reference_frame - result->frames.front().frame;
-  ProgressBegin(progress, "fit subdivision surface", count);
-  std::vector<int> order{reference_index};
-  for (int d = 1; d < count; ++d) {
-    if (reference_index - d >= 0) order.push_back(reference_index - d);
-    if (reference_index + d < count) order.push_back(reference_index + d);
-  }
-  int done = 0;
   const SurfaceRegistration registration(
       *result->hierarchy, options.registration,
       geometry::MeanEdgeLength(result->hierarchy->Topology(0), result->base_mesh.V));
-  geometry::Positions base_before, base_after, reference_control;  // sides i < and i > reference_index
-  for (int i : order) {
+  std::mutex store_mutex;  // the store and the progress
+  int done = 0;
+  // Fits frame i from `initial_base`; returns its control points of levels 0..n.
+  auto fit = [&](int i, const geometry::Positions& initial_base) {
     FrameShapeInit& frame = result->frames[i];
     const Stopwatch start;
-    const geometry::Positions& initial_base =
-        i == reference_index ? result->base_mesh.V : (i < reference_index ? base_before : base_after);
-    const geometry::ClosestPointTree hull_tree(store->LoadHull(frame.frame),
-                                               "visual hull of frame " + vision::FrameName(frame.frame));
+    geometry::TriangleMesh hull;
+    {
+      const std::lock_guard<std::mutex> lock(store_mutex);
+      hull = store->LoadHull(frame.frame);
+    }
+    const geometry::ClosestPointTree hull_tree(hull, "visual hull of frame " + vision::FrameName(frame.frame));
     // The reference frame's base is its own hull simplified: nothing to follow there.
     const geometry::Positions registered = i == reference_index
                                                ? initial_base
                                                : registration.Register(initial_base, hull_tree, &frame.registration);
-    const std::vector<geometry::Positions> control =
+    std::vector<geometry::Positions> control =
         FitHierarchyToSurface(*result->hierarchy, registered, hull_tree, options.fit, &frame.fit);
     frame.fit_seconds = start.Seconds();
-    if (i == reference_index) {
-      base_before = base_after = control.front();
-      reference_control = control.back();
-    } else {
-      (i < reference_index ? base_before : base_after) = control.front();
-    }
+    const std::lock_guard<std::mutex> lock(store_mutex);
     store->StoreControl(frame.frame, *result->hierarchy, control);
-    ProgressUpdate(progress, ++done);
-  }
+    ProgressUpdate(progress, static_cast<std::size_t>(++done));
+    return control;
+  };
+  ProgressBegin(progress, "fit subdivision surface", count);
+  const std::vector<geometry::Positions> reference = fit(reference_index, result->base_mesh.V);
+  // The frames after the reference frame (direction +1) or before it (-1).
+  auto side = [&](int direction) {
+    geometry::Positions base = reference.front();
+    for (int i = reference_index + direction; i >= 0 && i < count; i += direction) base = fit(i, base).front();
+  };
+  tbb::parallel_invoke([&] { side(+1); }, [&] { side(-1); });
   ProgressEnd(progress);
-  return reference_control;
+  return reference.back();
 }
 
 }  // namespace
 
 std::string ShapeInitResult::BriefReport() const {
-  double iou = 0, seconds = estimate_background_seconds + simplify_seconds;
+  double iou = 0;
   int with_iou = 0;
-  for (const FrameShapeInit& frame : frames) {
+  for (const FrameShapeInit& frame : frames)
     if (std::isfinite(frame.carving.mean_silhouette_iou)) iou += frame.carving.mean_silhouette_iou, ++with_iou;
-    seconds += frame.carve_seconds + frame.isosurface_seconds + frame.fit_seconds;
-  }
   const int levels = hierarchy ? hierarchy->finest_level() : 0;
   return fmt::format("shape init: {} frames ({}–{}), reference {}, base mesh {} vertices / {} faces, {} levels "
                      "(finest {} faces), mean silhouette IoU {:.4f}, {:.1f} s",
                      frames.size(), frames.empty() ? 0 : frames.front().frame, frames.empty() ? 0 : frames.back().frame,
                      reference_frame, base_mesh.vertex_count(), base_mesh.face_count(), levels,
-                     hierarchy ? hierarchy->FaceCount(levels) : 0, with_iou ? iou / with_iou : 0.0, seconds);
+                     hierarchy ? hierarchy->FaceCount(levels) : 0, with_iou ? iou / with_iou : 0.0, this->seconds);
 }
 
 void ShapeInitOptions::Check() const {
@@ -282,6 +325,7 @@ void ShapeInitOptions::Check() const {
 ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitOptions& options,
                                 Progress* progress, ShapeFrameStore* store) {
   options.Check();
+  const Stopwatch stage_start;
   const int available = dataset.frame_count() - options.first_frame;
   if (available <= 0)
     ThrowError(dataset.directory(), "first_frame",
@@ -373,6 +417,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
                result.hierarchy->FaceCount(levels));
 
   result.reference_control = FitEveryFrame(options, store, progress, &result);
+  result.seconds = stage_start.Seconds();
   return result;
 }
 

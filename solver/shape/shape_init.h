@@ -155,6 +155,9 @@ struct ShapeInitResult {
   // VoxelCarvingOptions::max_pixels_per_voxel).
   std::vector<double> evidence_scales;
   double simplify_seconds = 0;
+  // The whole stage, wall time (frames are carved, meshed and fitted side by side: the
+  // frames' carve / isosurface / fit seconds add up to more).
+  double seconds = 0;
 
   // One line: frames, base mesh, levels, mean silhouette IoU, seconds.
   std::string BriefReport() const;

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "geometry/local_frames.h"
 #include "geometry/mean_edge_length.h"
 #include "solver/stereo/stereo_refinement.h"
@@ -77,7 +78,7 @@ RefinementLevel PrepareLevel(const LoopHierarchy& hierarchy, const std::vector<v
 RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& hierarchy,
                             const std::vector<vision::Camera>& cameras, const StereoRefinementOptions& options,
                             const geometry::Trajectory& trajectory, const std::vector<Positions>& control,
-                            FrameImageCache* images, int first, int last) {
+                            FrameImageCache* images, int first, int last, int span_first, int span_last) {
   RefinementWindow window;
   window.options = &options;
   window.cameras = &cameras;
@@ -90,6 +91,12 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& h
   window.first = first;
   window.last = last;
   window.frame_count = static_cast<int>(control.size());
+  window.span_first = span_first < 0 ? 0 : span_first;
+  window.span_last = span_last < 0 ? window.frame_count - 1 : span_last;
+  if (window.span_first > first || window.span_last < last || window.span_last >= window.frame_count)
+    ThrowError("stereo refinement", "window",
+               "frames " + std::to_string(first) + "–" + std::to_string(last) + " outside their span " +
+                   std::to_string(window.span_first) + "–" + std::to_string(window.span_last));
   window.h = level.h;
   window.active_faces = level.active_faces;
   const geometry::Faces& F = hierarchy.LevelFaces(level.level);
@@ -97,7 +104,7 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& h
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     if (window.active_faces[f])
       for (int k = 0; k < 3; ++k) window.active_vertices[F(f, k)] = 1;
-  const int c0 = std::max(0, first - 1), c1 = std::min(window.frame_count - 1, last + 1);
+  const int c0 = std::max(window.span_first, first - 1), c1 = std::min(window.span_last, last + 1);
   for (int f = c0; f <= c1; ++f) {
     const SampleVisibilityFlags* known = images->Visibility(f, control[f]);
     SampleVisibilityFlags decided;

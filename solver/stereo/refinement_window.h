@@ -96,10 +96,13 @@ struct RefinementWindow {
   int dof = 1;            // unknowns per vertex: 3, or 1 (normal only)
   int first = 0, last = 0;  // the frames solved
   int frame_count = 0;    // frames of the sequence
+  // The frames the window may read (its context frames lie within): the whole sequence,
+  // or the half of it that a chain of windows refines while another refines the rest.
+  int span_first = 0, span_last = 0;
   double h = 0.0;         // mean edge length of the level: the unit of steps and weights
   std::vector<char> active_faces;     // #F(ℓ): refined at this level (adaptivity)
   std::vector<char> active_vertices;  // #V(ℓ): corners of active faces
-  std::map<int, FrameState> states;   // frames max(0, first − 1) … min(frame_count − 1, last + 1)
+  std::map<int, FrameState> states;   // frames max(span_first, first − 1) … min(span_last, last + 1)
   // Where the correlation blocks' views are sampled once per evaluation point (the
   // problem's evaluation callback, view_cache.h); null: each block samples its own.
   ViewCache* views = nullptr;
@@ -130,11 +133,13 @@ RefinementLevel PrepareLevel(const geometry::LoopHierarchy& hierarchy, const std
                              int level, std::vector<char> active_faces);
 
 // The window [first, last] of `level`: the states of its frames and context frames from the
-// current shapes (`trajectory`, finest control points `control`, all frames).
+// current shapes (`trajectory`, finest control points `control`, all frames). Context
+// frames only within [span_first, span_last] (−1: the sequence's first or last frame).
 RefinementWindow OpenWindow(const RefinementLevel& level, const geometry::LoopHierarchy& hierarchy,
                             const std::vector<vision::Camera>& cameras, const StereoRefinementOptions& options,
                             const geometry::Trajectory& trajectory, const std::vector<geometry::Positions>& control,
-                            FrameImageCache* images, int first, int last);
+                            FrameImageCache* images, int first, int last, int span_first = -1,
+                            int span_last = -1);
 
 // The state of one frame at level ℓ: `shape` and `finest_control` are the frame's current
 // multires shape and finest control points; `silhouettes` its signed distances per camera.

@@ -1,6 +1,7 @@
 #include "solver/stereo/stereo_refinement.h"
 
 #include <algorithm>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <utility>
@@ -8,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
+#include <tbb/parallel_invoke.h>
 
 #include "core/error.h"
 #include "core/stopwatch.h"
@@ -33,6 +35,43 @@ std::vector<std::pair<int, int>> Windows(int frames, int window, int overlap) {
     if (w1 == frames - 1) break;
   }
   return windows;
+}
+
+// A chain of windows solved one after another, reading only frames [span_first, span_last].
+struct WindowChain {
+  int span_first = 0, span_last = 0;
+  std::vector<std::pair<int, int>> windows;
+};
+
+// A level's windows: one chain over the take; or, with concurrent_halves on a take of at
+// least 3 windows, the two halves' chains side by side (neither reads a frame of the
+// other), then one window across the seam whose context is both halves' refined frames.
+struct WindowPlan {
+  std::vector<WindowChain> halves;
+  WindowChain seam;  // no window without halves
+
+  std::size_t Count() const {
+    std::size_t count = seam.windows.size();
+    for (const WindowChain& half : halves) count += half.windows.size();
+    return count;
+  }
+};
+
+WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options) {
+  auto chain = [&](int first, int last) {
+    WindowChain result{first, last, Windows(last - first + 1, options.window, options.window_overlap)};
+    for (auto& [w0, w1] : result.windows) w0 += first, w1 += first;
+    return result;
+  };
+  WindowPlan plan;
+  if (!options.concurrent_halves || frames < 3 * options.window) {
+    plan.halves.push_back(chain(0, frames - 1));
+    return plan;
+  }
+  const int middle = frames / 2, first = middle - options.window / 2;
+  plan.halves = {chain(0, middle - 1), chain(middle, frames - 1)};
+  plan.seam = {0, frames - 1, {{first, first + options.window - 1}}};
+  return plan;
 }
 
 // The refinement state of the whole sequence, which the windows' solutions move.
@@ -78,11 +117,18 @@ void ApplySolution(const LoopHierarchy& hierarchy, int level, const WindowSoluti
   }
 }
 
-// Refines level ℓ over all frames, window by window, `rounds` times; returns the vertices
-// of ℓ that moved by more than the adaptive threshold (the next level's active patches).
+// What the windows of one chain add up to over a round (the level's report sums them).
+struct ChainTally {
+  int parameters = 0, residual_blocks = 0, iterative_windows = 0, iterations = 0;
+  double solver_seconds = 0;
+};
+
+// Refines level ℓ over all frames, window by window (PlanWindows), `rounds` times; returns
+// the vertices of ℓ that moved by more than the adaptive threshold (the next level's
+// active patches). caches[i]: the frames of half i (the seam's with the first half's).
 std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHierarchy& hierarchy,
                               const vision::Bounds& bounds, const StereoRefinementOptions& options,
-                              int level, std::vector<char> active_faces, FrameImageCache* cache,
+                              int level, std::vector<char> active_faces, FrameImageCache* const caches[2],
                               SequenceState* state, Progress* progress, std::size_t* progress_done) {
   const Stopwatch start;
   const RefinementLevel prepared =
@@ -93,38 +139,62 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   report.patches = hierarchy.FaceCount(level);
   report.active_patches = static_cast<int>(std::count(prepared.active_faces.begin(), prepared.active_faces.end(), 1));
   report.active_fraction = static_cast<double>(report.active_patches) / report.patches;
-  std::vector<double> moved(hierarchy.VertexCount(level), 0.0);
-  const int frames = static_cast<int>(state->result->control.size());
-  const auto windows = Windows(frames, options.window, options.window_overlap);
-  report.windows = static_cast<int>(windows.size());
-  for (int round = 0; round < options.rounds; ++round) {
-    cache->ForgetVisibility();  // another level's samples, or another round
-    report.parameters = 0;
-    report.residual_blocks = 0;
-    report.iterative_windows = 0;
-    for (std::size_t w = 0; w < windows.size(); ++w) {
+  const WindowPlan plan = PlanWindows(static_cast<int>(state->result->control.size()), options);
+  report.windows = static_cast<int>(plan.Count());
+  // Per half: the largest displacement of every vertex (the halves write different frames).
+  std::vector<std::vector<double>> moved(plan.halves.size(), std::vector<double>(hierarchy.VertexCount(level), 0.0));
+  std::mutex progress_mutex;
+  auto run = [&](const WindowChain& chain, FrameImageCache* cache, std::vector<double>* chain_moved,
+                 ChainTally* tally) {
+    for (std::size_t w = 0; w < chain.windows.size(); ++w) {
+      const auto [first, last] = chain.windows[w];
       RefinementWindow window = OpenWindow(prepared, hierarchy, images.cameras, options, state->trajectory,
-                                           state->result->control, cache, windows[w].first, windows[w].second);
+                                           state->result->control, cache, first, last, chain.span_first,
+                                           chain.span_last);
       const WindowSolution solution = SolveWindow(window, bounds);
-      report.parameters += solution.parameters;
-      report.residual_blocks += solution.residual_blocks;
-      report.iterative_windows += solution.iterative;
-      report.iterations += solution.iterations;
-      report.solver_seconds += solution.solver_seconds;
-      ApplySolution(hierarchy, level, solution, state, &moved);
+      tally->parameters += solution.parameters;
+      tally->residual_blocks += solution.residual_blocks;
+      tally->iterative_windows += solution.iterative;
+      tally->iterations += solution.iterations;
+      tally->solver_seconds += solution.solver_seconds;
+      ApplySolution(hierarchy, level, solution, state, chain_moved);
       // The next window needs its frames and its context frame before them.
-      if (w + 1 < windows.size()) cache->Release(windows[w + 1].first - 1);
+      if (w + 1 < chain.windows.size()) cache->Release(chain.windows[w + 1].first - 1);
+      const std::lock_guard<std::mutex> lock(progress_mutex);
       ProgressUpdate(progress, ++*progress_done);
     }
+  };
+  for (int round = 0; round < options.rounds; ++round) {
+    std::vector<ChainTally> tallies(plan.halves.size());
+    for (std::size_t i = 0; i < plan.halves.size(); ++i)
+      caches[i]->ForgetVisibility();  // another level's samples, or another round
+    if (plan.halves.size() == 1) {
+      run(plan.halves[0], caches[0], &moved[0], &tallies[0]);
+    } else {
+      tbb::parallel_invoke([&] { run(plan.halves[0], caches[0], &moved[0], &tallies[0]); },
+                           [&] { run(plan.halves[1], caches[1], &moved[1], &tallies[1]); });
+      run(plan.seam, caches[0], &moved[0], &tallies[0]);
+    }
+    report.parameters = report.residual_blocks = report.iterative_windows = 0;  // the last round's
+    for (const ChainTally& tally : tallies) {
+      report.parameters += tally.parameters;
+      report.residual_blocks += tally.residual_blocks;
+      report.iterative_windows += tally.iterative_windows;
+      report.iterations += tally.iterations;
+      report.solver_seconds += tally.solver_seconds;
+    }
   }
+  for (std::size_t i = 1; i < moved.size(); ++i)
+    for (std::size_t v = 0; v < moved[0].size(); ++v) moved[0][v] = std::max(moved[0][v], moved[i][v]);
   double moved_sum = 0.0;
-  std::vector<char> moved_vertices(moved.size(), 0);  // 0: still, 1: moved, 2: moved a lot
-  for (std::size_t v = 0; v < moved.size(); ++v) {
-    moved_sum += moved[v];
-    if (moved[v] > options.adaptive_threshold * prepared.h) moved_vertices[v] = 1;
-    if (options.detail_threshold > 0.0 && moved[v] > options.detail_threshold * prepared.h) moved_vertices[v] = 2;
+  std::vector<char> moved_vertices(moved[0].size(), 0);  // 0: still, 1: moved, 2: moved a lot
+  for (std::size_t v = 0; v < moved[0].size(); ++v) {
+    const double distance = moved[0][v];
+    moved_sum += distance;
+    if (distance > options.adaptive_threshold * prepared.h) moved_vertices[v] = 1;
+    if (options.detail_threshold > 0.0 && distance > options.detail_threshold * prepared.h) moved_vertices[v] = 2;
   }
-  report.mean_increment = moved_sum / static_cast<double>(moved.size());
+  report.mean_increment = moved_sum / static_cast<double>(moved_vertices.size());
   report.seconds = start.Seconds();
   spdlog::info("refinement level {}: {} of {} patches, dof {}, {} unknowns, {} residual blocks, "
                "{} iterations, mean max |increment| {:.3g}, {:.1f} s ({:.1f} s in Ceres)",
@@ -257,16 +327,16 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
   result.frames.resize(control.size());
   for (std::size_t f = 0; f < control.size(); ++f) result.frames[f].frame = static_cast<int>(f);
   SequenceState state{geometry::AnalyzeTrajectory(hierarchy, control), &result};
-  FrameImageCache cache(images, options.image_sigma);
+  FrameImageCache first_half(images, options.image_sigma), second_half(images, options.image_sigma);
+  FrameImageCache* const caches[2] = {&first_half, &second_half};
 
-  const int frames = static_cast<int>(control.size());
-  const std::size_t windows = Windows(frames, options.window, options.window_overlap).size();
+  const std::size_t windows = PlanWindows(static_cast<int>(control.size()), options).Count();
   ProgressBegin(progress, "refinement",
                 static_cast<std::size_t>(finest_refined - options.coarsest_level + 1) * options.rounds * windows);
   std::size_t done = 0;
   std::vector<char> active(hierarchy.FaceCount(options.coarsest_level), 1);
   for (int level = options.coarsest_level; level <= finest_refined; ++level) {
-    const std::vector<char> moved = RefineLevel(images, hierarchy, bounds, options, level, active, &cache, &state,
+    const std::vector<char> moved = RefineLevel(images, hierarchy, bounds, options, level, active, caches, &state,
                                                 progress, &done);
     if (level == finest_refined) break;
     // Adaptivity: a child face is refined when its parent was and one of the parent's

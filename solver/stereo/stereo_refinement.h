@@ -142,6 +142,12 @@ struct StereoRefinementOptions {
   // 1 → 0.0536 / 0.553 (14), 2 → 0.0527 / 0.540 (16); with the increments' level-0 term
   // as now, 0 → 0.0637 / 0.509, 2 → 0.0580 / 0.510.
   int window_overlap = 2;
+  // Takes of at least 3 windows' frames refined as two halves side by side, each window
+  // by window, then a window across the seam with both halves as its context (Ceres 2.1's
+  // iterative solver multiplies by the Jacobian on one thread: one half's solve fills the
+  // core the other's leaves idle). Off by default: on pose2sim frames 40–63 it took 102 s
+  // against 118 s but raised the peak memory from 2.4 to 3.8 GB (docs/speed.md).
+  bool concurrent_halves = false;
   // Visibility/sample updates per level (visibility is recomputed at every level anyway).
   int rounds = 1;
   WindowSolverOptions solver;

@@ -110,9 +110,10 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
     ceres::Solve(options.solver.ToCeres(solution.parameters), &problem, &summary);
     solution.solver_seconds = solve_start.Seconds();
     solution.iterations = static_cast<int>(summary.iterations.size());
-    std::string costs;
+    std::string costs;  // and the linear solver's iterations in brackets
     for (const ceres::IterationSummary& iteration : summary.iterations)
-      costs += fmt::format("{}{:.4g}{}", costs.empty() ? "" : " ", iteration.cost, iteration.step_is_successful ? "" : "✗");
+      costs += fmt::format("{}{:.4g}{} [{}]", costs.empty() ? "" : " ", iteration.cost,
+                           iteration.step_is_successful ? "" : "✗", iteration.linear_solver_iterations);
     spdlog::debug("refinement level {} frames {}–{}: {} residuals in {} blocks, {} views; {}; jacobians {:.2f} s, "
                   "residuals {:.2f} s, linear solver {:.2f} s; cost per iteration {}", window.level, window.first,
                   window.last, problem.NumResiduals(), problem.NumResidualBlocks(), views.size(),

@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <tbb/task_arena.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "geometry/closest_point.h"
@@ -443,6 +444,32 @@ TEST(ShapeInit, AFrameStoreReceivesEveryHullAndFitWithTheSameValues) {
   }
   EXPECT_EQ(stored.base_mesh.F, in_memory.base_mesh.F);
   EXPECT_EQ(stored.reference_control, in_memory.frames[2].control.back());
+}
+
+// Frames are carved, meshed and fitted side by side (the iso-surfaces of consecutive
+// frames, the fits of the two sides of the reference frame): every hull, fit and figure is
+// exactly what one thread computes frame after frame.
+TEST(ShapeInit, FramesSideBySideGiveExactlyWhatOneThreadGives) {
+  const fs::path directory = Scratch().FreshPath("threads");
+  vision::WriteSyntheticDataset(directory.string(), SphereOptions("dome", 6, 160, 120, 7));
+  const vision::Dataset dataset(directory.string());
+  ShapeInitResult one_thread;
+  tbb::task_arena(1).execute([&] { one_thread = InitializeShape(dataset, QuickOptions()); });
+  const ShapeInitResult side_by_side = InitializeShape(dataset, QuickOptions());
+  ASSERT_EQ(side_by_side.frames.size(), 7u);
+  ASSERT_EQ(one_thread.frames.size(), 7u);
+  for (std::size_t i = 0; i < side_by_side.frames.size(); ++i) {
+    const FrameShapeInit& frame = side_by_side.frames[i];
+    const FrameShapeInit& expected = one_thread.frames[i];
+    ASSERT_GT(frame.hull.vertex_count(), 0) << "frame " << frame.frame;
+    EXPECT_EQ(frame.hull.V, expected.hull.V) << "frame " << frame.frame;
+    EXPECT_EQ(frame.hull.F, expected.hull.F) << "frame " << frame.frame;
+    EXPECT_EQ(frame.control, expected.control) << "frame " << frame.frame;
+    EXPECT_EQ(frame.carving.carved_voxels, expected.carving.carved_voxels) << "frame " << frame.frame;
+    EXPECT_EQ(frame.registration.iterations, expected.registration.iterations) << "frame " << frame.frame;
+  }
+  EXPECT_EQ(side_by_side.reference_control, one_thread.reference_control);
+  EXPECT_GT(side_by_side.seconds, 0.0);
 }
 
 }  // namespace

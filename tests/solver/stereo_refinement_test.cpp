@@ -139,15 +139,21 @@ TEST(StereoRefinement, WindowsRecordTheirLinearSolver) {
   EXPECT_FALSE(nothing.iterative);
 }
 
+// Level 0 only, 2-frame windows sharing one frame.
+StereoRefinementOptions LevelZeroOverlapOptions() {
+  StereoRefinementOptions options = TestOptions();
+  options.window_overlap = 1;
+  options.finest_level = 0;
+  return options;
+}
+
 // Overlapping windows: with 2-frame windows sharing one frame, 3 frames take 2 windows and
 // the middle frame is solved in both; every frame is refined and moves back.
 TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
   const testing::RefinementScene& scene = Scene();
   const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
   const double before = scene.RmsDistanceToTruth(perturbed);
-  StereoRefinementOptions options = TestOptions();
-  options.window_overlap = 1;
-  options.finest_level = 0;
+  StereoRefinementOptions options = LevelZeroOverlapOptions();
   const RefinementResult result = scene.Refine(perturbed, 3, options);
   ASSERT_EQ(result.levels.size(), 1u);
   EXPECT_EQ(result.levels[0].windows, 2);
@@ -162,6 +168,28 @@ TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
   EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 3);
   options.window_overlap = 2;  // at most window − 1 = 0 frames are shared
   EXPECT_EQ(scene.Refine(perturbed, 3, options).levels[0].windows, 3);
+}
+
+// concurrent_halves: frames [0, 2] and [3, 5] refined side by side (windows [0, 1], [1, 2]
+// and [3, 4], [4, 5] with overlap 1), then the seam window [2, 3]: every frame is refined,
+// as close to the truth as one chain of windows gets it.
+TEST(StereoRefinement, HalvesSideBySideRefineEveryFrameAsOneChainDoes) {
+  const testing::RefinementScene& scene = Scene();
+  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const double before = scene.RmsDistanceToTruth(perturbed);
+  StereoRefinementOptions options = LevelZeroOverlapOptions();
+  const RefinementResult one_chain = scene.Refine(perturbed, 6, options);
+  options.concurrent_halves = true;
+  const RefinementResult halves = scene.Refine(perturbed, 6, options);
+  ASSERT_EQ(halves.levels.size(), 1u);
+  EXPECT_EQ(one_chain.levels[0].windows, 5);  // [0, 1] … [4, 5]
+  EXPECT_EQ(halves.levels[0].windows, 5);     // two per half and the seam's
+  for (std::size_t f = 0; f < halves.control.size(); ++f) {
+    EXPECT_GT(halves.frames[f].stereo_pairs, 0) << "frame " << f;
+    const double after = scene.RmsDistanceToTruth(halves.control[f]);
+    EXPECT_LT(after, before) << "frame " << f;
+    EXPECT_LT(after, 1.5 * scene.RmsDistanceToTruth(one_chain.control[f]) + 1e-5) << "frame " << f;
+  }
 }
 
 TEST(StereoRefinement, RejectsBadInput) {
