@@ -151,7 +151,7 @@ int AddTemporalResiduals(RefinementWindow& window, int frame, int face, const Pa
   const std::vector<int>& support = window.sampling->support[face];
   const int support_size = static_cast<int>(support.size());
   std::vector<std::pair<int, int>> steps;
-  if (frame + 1 <= window.span_last) steps.emplace_back(frame, frame + 1);
+  if (frame + 1 <= window.SpanLast()) steps.emplace_back(frame, frame + 1);
   if (frame == window.first && frame > window.span_first) steps.emplace_back(frame - 1, frame);
   int added = 0;
   for (const auto& [ta, tb] : steps) {

@@ -92,11 +92,11 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& h
   window.last = last;
   window.frame_count = static_cast<int>(control.size());
   window.span_first = span_first < 0 ? 0 : span_first;
-  window.span_last = span_last < 0 ? window.frame_count - 1 : span_last;
-  if (window.span_first > first || window.span_last < last || window.span_last >= window.frame_count)
+  window.span_last = span_last;
+  if (window.span_first > first || window.SpanLast() < last || window.SpanLast() >= window.frame_count)
     ThrowError("stereo refinement", "window",
                "frames " + std::to_string(first) + "–" + std::to_string(last) + " outside their span " +
-                   std::to_string(window.span_first) + "–" + std::to_string(window.span_last));
+                   std::to_string(window.span_first) + "–" + std::to_string(window.SpanLast()));
   window.h = level.h;
   window.active_faces = level.active_faces;
   const geometry::Faces& F = hierarchy.LevelFaces(level.level);
@@ -104,7 +104,7 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& h
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     if (window.active_faces[f])
       for (int k = 0; k < 3; ++k) window.active_vertices[F(f, k)] = 1;
-  const int c0 = std::max(window.span_first, first - 1), c1 = std::min(window.span_last, last + 1);
+  const int c0 = std::max(window.span_first, first - 1), c1 = std::min(window.SpanLast(), last + 1);
   for (int f = c0; f <= c1; ++f) {
     const SampleVisibilityFlags* known = images->Visibility(f, control[f]);
     SampleVisibilityFlags decided;

@@ -98,7 +98,8 @@ struct RefinementWindow {
   int frame_count = 0;    // frames of the sequence
   // The frames the window may read (its context frames lie within): the whole sequence,
   // or the half of it that a chain of windows refines while another refines the rest.
-  int span_first = 0, span_last = 0;
+  // span_last −1: the sequence's last frame (SpanLast()).
+  int span_first = 0, span_last = -1;
   double h = 0.0;         // mean edge length of the level: the unit of steps and weights
   std::vector<char> active_faces;     // #F(ℓ): refined at this level (adaptivity)
   std::vector<char> active_vertices;  // #V(ℓ): corners of active faces
@@ -107,6 +108,7 @@ struct RefinementWindow {
   // problem's evaluation callback, view_cache.h); null: each block samples its own.
   ViewCache* views = nullptr;
 
+  int SpanLast() const { return span_last < 0 ? frame_count - 1 : span_last; }
   double* Increment(int frame, int vertex) {
     return states.at(frame).increments.data() + static_cast<std::ptrdiff_t>(vertex) * dof;
   }

@@ -28,7 +28,7 @@ void AddMembraneResidual(RefinementWindow& window, int frame, int vertex, ceres:
 
 void AddTemporalSmoothnessResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem) {
   const double weight = window.options->temporal_smoothness;
-  if (weight <= 0 || frame <= window.span_first || frame >= window.span_last) return;
+  if (weight <= 0 || frame <= window.span_first || frame >= window.SpanLast()) return;
   // Measured with 2-frame overlaps: on synth rigid, a level-0 term on the world
   // trajectories gave accuracy P90 0.94 mm against 0.80 mm with this one (end-point error
   // 0.101 against 0.107 mm); on blob frames 0–11 it gave 0.540 against 0.510 mm (end-point
