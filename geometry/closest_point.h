@@ -1,5 +1,8 @@
 // Queries against a fixed triangle mesh: closest surface point, ray casting and
-// inside/outside, answered by a CGAL AABB tree (kept inside closest_point_cgal.cpp).
+// inside/outside. Closest points and inside/outside are answered by a CGAL AABB tree (kept
+// inside closest_point_cgal.cpp); rays by Embree (geometry/ray_caster.h), with CGAL's
+// exact-predicate traversal kept as the reference they are tested and benchmarked against
+// (RayEngine::kCgal).
 //
 // Conventions
 //   A surface point is (face f, barycentric (u, v)):
@@ -41,6 +44,10 @@ struct RayHit {
 
 enum class PointSide { kInside, kOnSurface, kOutside };
 
+// Who answers ray queries: Embree (float BVH, hit parameter refined in double; the
+// default), or CGAL's AABB tree with exact predicates (the reference).
+enum class RayEngine { kEmbree, kCgal };
+
 class ClosestPointTree {
  public:
   // Copies V and F and builds the tree. Throws subflow::Error (naming `source`) when F
@@ -64,16 +71,19 @@ class ClosestPointTree {
   // First surface point along the ray origin + t·direction, t ∈ [0, max_t]. `hit` is
   // false when there is none (or `direction` is zero).
   RayHit FirstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                  double max_t = std::numeric_limits<double>::infinity()) const;
+                  double max_t = std::numeric_limits<double>::infinity(),
+                  RayEngine engine = RayEngine::kEmbree) const;
   // The surface point on the whole line origin + t·direction nearest to the origin
   // (smallest |t|, either direction), |t| ≤ max_abs_t. For snapping a point to a
   // surface along its normal.
   RayHit NearestHitOnLine(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                          double max_abs_t = std::numeric_limits<double>::infinity()) const;
+                          double max_abs_t = std::numeric_limits<double>::infinity(),
+                          RayEngine engine = RayEngine::kEmbree) const;
   // NearestHitOnLine over rows of `origins` and `directions` (#Q×3 each), in parallel.
   std::vector<RayHit> NearestHitsOnLines(
       const Positions& origins, const Positions& directions,
-      double max_abs_t = std::numeric_limits<double>::infinity()) const;
+      double max_abs_t = std::numeric_limits<double>::infinity(),
+      RayEngine engine = RayEngine::kEmbree) const;
 
   // Inside / outside of the volume bounded by the mesh: the ray-parity test of
   // CGAL::Side_of_triangle_mesh (crossings of a ray from the point, re-cast when a ray

@@ -18,6 +18,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
+#include "geometry/ray_caster.h"
 
 namespace subflow::geometry {
 namespace {
@@ -150,6 +151,7 @@ struct ClosestPointTree::Impl {
   std::vector<int> face_of_triangle;  // triangles[i] is face face_of_triangle[i]
   Tree tree;
   CGAL::Bbox_3 bbox;
+  std::unique_ptr<RayCaster> caster;  // the same faces as the tree
 
   int FaceOf(TriangleIterator it) const {
     return face_of_triangle[static_cast<std::size_t>(it - triangles.cbegin())];
@@ -184,6 +186,8 @@ struct ClosestPointTree::Impl {
     result.t = std::max(0.0, (point - origin).dot(unit_direction));
     return result;
   }
+  RayHit CastBy(RayEngine engine, const Eigen::Vector3d& origin, const Eigen::Vector3d& unit_direction,
+                double max_t) const;
 };
 
 ClosestPointTree::ClosestPointTree(const TriangleMesh& mesh, const std::string& source)
@@ -214,6 +218,7 @@ ClosestPointTree::ClosestPointTree(const TriangleMesh& mesh, const std::string& 
   // Built now, not lazily on the first (possibly concurrent) query.
   impl.tree.accelerate_distance_queries();
   impl.bbox = impl.tree.bbox();
+  impl.caster = std::make_unique<RayCaster>(impl.mesh, impl.face_of_triangle);
 }
 
 ClosestPointTree::~ClosestPointTree() = default;
@@ -247,27 +252,32 @@ Eigen::VectorXd ClosestPointTree::Distances(const Positions& queries) const {
   return result;
 }
 
+RayHit ClosestPointTree::Impl::CastBy(RayEngine engine, const Eigen::Vector3d& origin,
+                                      const Eigen::Vector3d& unit_direction, double max_t) const {
+  return engine == RayEngine::kEmbree ? caster->Cast(origin, unit_direction, max_t) : Cast(origin, unit_direction, max_t);
+}
+
 RayHit ClosestPointTree::FirstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                                  double max_t) const {
+                                  double max_t, RayEngine engine) const {
   const double norm = direction.norm();
   if (!(norm > 0.0) || !origin.allFinite() || !direction.allFinite()) return {};
-  RayHit hit = impl_->Cast(origin, direction / norm, max_t);
+  RayHit hit = impl_->CastBy(engine, origin, direction / norm, max_t);
   if (hit.hit && hit.t > max_t) return {};
   return hit;
 }
 
 RayHit ClosestPointTree::NearestHitOnLine(const Eigen::Vector3d& origin,
                                           const Eigen::Vector3d& direction,
-                                          double max_abs_t) const {
+                                          double max_abs_t, RayEngine engine) const {
   const double norm = direction.norm();
   if (!(norm > 0.0) || !origin.allFinite() || !direction.allFinite()) return {};
   const Eigen::Vector3d unit = direction / norm;
-  RayHit best = impl_->Cast(origin, unit, max_abs_t);
+  RayHit best = impl_->CastBy(engine, origin, unit, max_abs_t);
   if (best.hit && best.t > max_abs_t) best = {};
   if (best.hit && best.t == 0.0) return best;  // no backward hit can be nearer
   // A backward hit farther than the forward one would lose: search only that far (a short
   // segment's traversal visits few boxes of the tree).
-  RayHit backward = impl_->Cast(origin, -unit, best.hit ? best.t : max_abs_t);
+  RayHit backward = impl_->CastBy(engine, origin, -unit, best.hit ? best.t : max_abs_t);
   if (backward.hit && backward.t <= max_abs_t && (!best.hit || backward.t < best.t)) {
     backward.t = -backward.t;
     best = backward;
@@ -277,12 +287,12 @@ RayHit ClosestPointTree::NearestHitOnLine(const Eigen::Vector3d& origin,
 
 std::vector<RayHit> ClosestPointTree::NearestHitsOnLines(const Positions& origins,
                                                          const Positions& directions,
-                                                         double max_abs_t) const {
+                                                         double max_abs_t, RayEngine engine) const {
   SUBFLOW_CHECK(origins.rows() == directions.rows(), "one direction per origin");
   std::vector<RayHit> result(static_cast<std::size_t>(origins.rows()));
   ParallelRows(origins.rows(), [&](Eigen::Index i) {
     result[i] = NearestHitOnLine(Eigen::Vector3d(origins.row(i).transpose()),
-                                 Eigen::Vector3d(directions.row(i).transpose()), max_abs_t);
+                                 Eigen::Vector3d(directions.row(i).transpose()), max_abs_t, engine);
   });
   return result;
 }

@@ -12,6 +12,7 @@ packages=(
   libopenblas0-pthread  # the BLAS of CHOLMOD (CMakeLists.txt: SYSTEM_BLAS_LIBRARY)
   libtet1.5-dev
   libtbb-dev
+  libembree-dev  # ray casts against hulls (geometry/ray_caster.h)
   libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libtinygltf-dev
   libpugixml-dev libtomlplusplus-dev  # calibration importers: Qualisys XML, Pose2Sim/Anipose TOML

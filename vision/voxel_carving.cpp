@@ -6,6 +6,7 @@
 #include <string>
 
 #include <opencv2/imgproc.hpp>
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -140,12 +141,34 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
 
 std::string FrameLabel(int frame) { return "frame " + std::to_string(frame); }
 
-void Warn(CarvingResult* result, const std::string& message) {
-  spdlog::warn("{}", message);
+void Warn(CarvingResult* result, const std::string& message, spdlog::level::level_enum level = spdlog::level::warn) {
+  spdlog::log(level, "{}", message);
   result->warnings.push_back(message);
 }
 
 }  // namespace
+
+const char* const kBorderSides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+
+std::vector<std::string> SummarizeBorderContacts(const std::vector<const CarvingResult*>& frames) {
+  std::vector<std::string> lines;
+  for (int side = 0; side < 6; ++side) {
+    int touching = 0, first = 0, last = 0;
+    std::size_t most = 0;
+    for (const CarvingResult* frame : frames) {
+      if (frame->border_voxels[side] == 0) continue;
+      if (touching++ == 0) first = frame->frame;
+      last = frame->frame;
+      most = std::max(most, frame->border_voxels[side]);
+    }
+    if (touching == 0) continue;
+    lines.push_back(fmt::format("the object touches the {} side of the working volume in {} of {} frames ({}–{}; up "
+                                "to {} voxels): it may extend beyond the bounds (report.json: "
+                                "shape_init.frames[].border_voxels)",
+                                kBorderSides[side], touching, frames.size(), first, last, most));
+  }
+  return lines;
+}
 
 void VoxelCarvingOptions::Check() const {
   auto fail = [](const char* field, const std::string& expected, double value) {
@@ -324,12 +347,12 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
         result.border_voxels[2] += j == 0, result.border_voxels[3] += j == occupancy.ny - 1;
         result.border_voxels[4] += k == 0, result.border_voxels[5] += k == occupancy.nz - 1;
       }
-  static const char* kSides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
   for (int side = 0; side < 6; ++side)
     if (result.border_voxels[side] > 0)
-      Warn(&result, where + ": the object touches the " + kSides[side] + " side of the working volume (" +
-                        std::to_string(result.border_voxels[side]) +
-                        " voxels): it may extend beyond the bounds");
+      Warn(&result,
+           where + ": the object touches the " + kBorderSides[side] + " side of the working volume (" +
+               std::to_string(result.border_voxels[side]) + " voxels): it may extend beyond the bounds",
+           options.log_border_warnings ? spdlog::level::warn : spdlog::level::debug);
   if (options.compute_silhouette_iou) {
     double sum = 0;
     for (const CarvingCamera& c : used) sum += result.cameras[c.index].silhouette_iou;

@@ -112,6 +112,10 @@ struct VoxelCarvingOptions {
   bool compute_silhouette_iou = true;
   // Worker threads (TBB); 0 = all available, 1 = serial (e.g. for a benchmark baseline).
   int threads = 0;
+  // Log "the object touches the … side" at warning level (else at debug level; the
+  // warning is in CarvingResult::warnings either way). Shape initialization turns this off
+  // and logs one line per side for the whole take (SummarizeBorderContacts).
+  bool log_border_warnings = true;
 
   // Throws subflow::Error naming the field when an option is out of range.
   void Check() const;
@@ -149,6 +153,12 @@ struct CarvingResult {
   double mean_silhouette_iou = std::numeric_limits<double>::quiet_NaN();  // over used cameras
   std::vector<std::string> warnings;
 };
+
+// The grid's sides in border_voxels order: "-x", "+x", "-y", "+y", "-z", "+z".
+extern const char* const kBorderSides[6];
+// One line per side that the object touches in any of `frames` (the carvings of a take):
+// in how many frames, the first and last of them, and the most voxels in one frame.
+std::vector<std::string> SummarizeBorderContacts(const std::vector<const CarvingResult*>& frames);
 
 // The voxel count along the longest axis: options.resolution when > 0, else automatic:
 // spacing = pixels_per_voxel / max_k (f_k / depth_k(centre)) over the cameras that see

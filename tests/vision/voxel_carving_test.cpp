@@ -277,7 +277,7 @@ TEST(VoxelCarving, BadCamerasAreExcludedWithAWarningAndTheRestIsCarved) {
   EXPECT_THROW(CarveVoxels(SixCameras(), {silhouettes[0]}, kBounds, options), Error);  // count mismatch
 }
 
-TEST(VoxelCarving, ObjectLeavingTheBoundsIsReportedWithFrameAndSide) {
+TEST(VoxelCarving, ObjectLeavingTheBoundsIsReportedWithFrameAndSideAndSummarizedOverATake) {
   const Sphere sphere;
   const std::vector<Camera> cameras = SixCameras();
   Bounds cut = kBounds;
@@ -292,6 +292,23 @@ TEST(VoxelCarving, ObjectLeavingTheBoundsIsReportedWithFrameAndSide) {
   ASSERT_EQ(result.warnings.size(), 1u);
   EXPECT_NE(result.warnings[0].find("frame 5: the object touches the +x side"), std::string::npos)
       << result.warnings[0];
+
+  // A take: one line per side over its frames, not one per frame (the same warning stays in
+  // each frame's result, for report.json).
+  options.log_border_warnings = false;
+  std::vector<CarvingResult> take;
+  for (int frame : {3, 4, 7}) take.push_back(CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), cut, options, frame));
+  take.push_back(CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), kBounds, options, 8));  // inside
+  ASSERT_EQ(take[0].warnings.size(), 1u);
+  std::vector<const CarvingResult*> frames;
+  for (const CarvingResult& frame : take) frames.push_back(&frame);
+  const std::vector<std::string> lines = SummarizeBorderContacts(frames);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find("touches the +x side of the working volume in 3 of 4 frames (3–7; up to " +
+                          std::to_string(result.border_voxels[1]) + " voxels)"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_TRUE(SummarizeBorderContacts({frames.back()}).empty());
 }
 
 TEST(VoxelCarving, OptionsAreChecked) {
