@@ -352,7 +352,7 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
       Warn(&result,
            where + ": the object touches the " + kBorderSides[side] + " side of the working volume (" +
                std::to_string(result.border_voxels[side]) + " voxels): it may extend beyond the bounds",
-           options.log_border_warnings ? spdlog::level::warn : spdlog::level::debug);
+           spdlog::level::debug);  // summarized over the take (SummarizeBorderContacts)
   if (options.compute_silhouette_iou) {
     double sum = 0;
     for (const CarvingCamera& c : used) sum += result.cameras[c.index].silhouette_iou;

@@ -112,10 +112,6 @@ struct VoxelCarvingOptions {
   bool compute_silhouette_iou = true;
   // Worker threads (TBB); 0 = all available, 1 = serial (e.g. for a benchmark baseline).
   int threads = 0;
-  // Log "the object touches the … side" at warning level (else at debug level; the
-  // warning is in CarvingResult::warnings either way). Shape initialization turns this off
-  // and logs one line per side for the whole take (SummarizeBorderContacts).
-  bool log_border_warnings = true;
 
   // Throws subflow::Error naming the field when an option is out of range.
   void Check() const;
@@ -158,6 +154,9 @@ struct CarvingResult {
 extern const char* const kBorderSides[6];
 // One line per side that the object touches in any of `frames` (the carvings of a take):
 // in how many frames, the first and last of them, and the most voxels in one frame.
+// CarveVoxels records "frame F: the object touches the … side" in its result's warnings
+// but logs it at debug level only: a take has it in most frames, so shape initialization
+// logs these lines instead.
 std::vector<std::string> SummarizeBorderContacts(const std::vector<const CarvingResult*>& frames);
 
 // The voxel count along the longest axis: options.resolution when > 0, else automatic:

@@ -349,8 +349,8 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   // Evidence on images reduced to what the voxel grid resolves (vision/working_scale.h),
   // the grid's resolution and morphology fixed first on the stored images, so that they do
   // not follow the reduced cameras.
-  vision::VoxelCarvingOptions carving = vision::ResolveCarvingOptions(dataset.cameras(), dataset.bounds(), options.carving);
-  carving.log_border_warnings = false;  // one line per side for the take, below
+  const vision::VoxelCarvingOptions carving =
+      vision::ResolveCarvingOptions(dataset.cameras(), dataset.bounds(), options.carving);
   const double voxel_size = dataset.bounds().Size().maxCoeff() / carving.resolution;
   result.evidence_scales.resize(dataset.camera_count());
   for (int k = 0; k < dataset.camera_count(); ++k)
@@ -394,7 +394,8 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   std::vector<const vision::CarvingResult*> carvings;
   for (int i = 0; i < count; ++i)
     if (has_evidence[i]) carvings.push_back(&result.frames[i].carving);
-  for (const std::string& line : vision::SummarizeBorderContacts(carvings)) spdlog::warn("{}", line);
+  for (const std::string& line : vision::SummarizeBorderContacts(carvings))  // one line per side, not per frame
+    spdlog::warn("{}", line);
   for (vision::EstimatedBackground& estimated : result.estimated_backgrounds)  // memory: keep the figures
     estimated.image.release(), estimated.known.release(), estimated.instability.release();
   for (vision::Silhouette& standing : result.standing)

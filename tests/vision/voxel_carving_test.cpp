@@ -295,7 +295,6 @@ TEST(VoxelCarving, ObjectLeavingTheBoundsIsReportedWithFrameAndSideAndSummarized
 
   // A take: one line per side over its frames, not one per frame (the same warning stays in
   // each frame's result, for report.json).
-  options.log_border_warnings = false;
   std::vector<CarvingResult> take;
   for (int frame : {3, 4, 7}) take.push_back(CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), cut, options, frame));
   take.push_back(CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), kBounds, options, 8));  // inside
