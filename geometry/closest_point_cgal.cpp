@@ -151,7 +151,7 @@ struct ClosestPointTree::Impl {
   std::vector<int> face_of_triangle;  // triangles[i] is face face_of_triangle[i]
   Tree tree;
   CGAL::Bbox_3 bbox;
-  std::unique_ptr<RayCaster> caster;  // the same faces as the tree
+  std::unique_ptr<RayCaster> caster;  // the same faces as the tree; reads `mesh` (declared before it)
 
   int FaceOf(TriangleIterator it) const {
     return face_of_triangle[static_cast<std::size_t>(it - triangles.cbegin())];

@@ -28,10 +28,10 @@ namespace subflow::geometry {
 
 class RayCaster {
  public:
-  // `faces` lists the rows of mesh.F to put in the scene (the others are never hit);
-  // empty = all of them. The mesh must be finite with valid indices (ClosestPointTree
-  // checks that before building one).
-  explicit RayCaster(const TriangleMesh& mesh, std::vector<int> faces = {});
+  // `faces` lists the rows of mesh.F to put in the scene (the others are never hit). The
+  // mesh must be finite with valid indices (ClosestPointTree checks that before building
+  // one), and must outlive the caster: it is read, not copied (ClosestPointTree owns both).
+  RayCaster(const TriangleMesh& mesh, std::vector<int> faces);
   ~RayCaster();
   RayCaster(RayCaster&&) noexcept;
   RayCaster& operator=(RayCaster&&) noexcept;

@@ -32,7 +32,7 @@ void CheckDevice(const char* what) {
 }  // namespace
 
 struct RayCaster::Impl {
-  TriangleMesh mesh;
+  const TriangleMesh* mesh = nullptr;  // the caller's, read for the hits in double
   std::vector<int> faces;      // scene primitive i is row faces[i] of F
   Eigen::Vector3d centre;      // the scene's vertices are V − centre, in float
   float slack = 0.0f;          // float rounding of the mesh, in world units
@@ -45,11 +45,7 @@ struct RayCaster::Impl {
 
 RayCaster::RayCaster(const TriangleMesh& mesh, std::vector<int> faces) : impl_(std::make_unique<Impl>()) {
   Impl& impl = *impl_;
-  impl.mesh = mesh;
-  if (faces.empty()) {
-    faces.resize(static_cast<std::size_t>(mesh.face_count()));
-    for (int f = 0; f < mesh.face_count(); ++f) faces[f] = f;
-  }
+  impl.mesh = &mesh;
   impl.faces = std::move(faces);
   const Eigen::Vector3d low = mesh.V.colwise().minCoeff(), high = mesh.V.colwise().maxCoeff();
   impl.centre = 0.5 * (low + high);
@@ -111,8 +107,8 @@ RayHit RayCaster::Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& uni
   if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return result;
   const int face = impl.faces[query.hit.primID];
   // The hit's parameter again in double, on the plane of the triangle Embree chose.
-  const Positions& V = impl.mesh.V;
-  const Faces& F = impl.mesh.F;
+  const Positions& V = impl.mesh->V;
+  const Faces& F = impl.mesh->F;
   const Eigen::Vector3d a = V.row(F(face, 0)), b = V.row(F(face, 1)), c = V.row(F(face, 2));
   const Eigen::Vector3d normal = (b - a).cross(c - a);
   const double along = normal.dot(unit_direction);
@@ -122,7 +118,7 @@ RayHit RayCaster::Cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& uni
   result.t = std::max(0.0, t);
   result.point = origin + result.t * unit_direction;
   result.face = face;
-  result.barycentric = FaceBarycentric(impl.mesh, face, result.point);
+  result.barycentric = FaceBarycentric(*impl.mesh, face, result.point);
   return result;
 }
 

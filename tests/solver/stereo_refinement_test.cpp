@@ -33,6 +33,13 @@ StereoRefinementOptions TestOptions() {
   return options;
 }
 
+// The start of the tests that refine towards the truth: the scene's control points moved
+// 1.5 mm along their normals.
+const Positions& PerturbedStart() {
+  static const Positions perturbed = Perturbed(Scene().scene.hierarchy, Scene().scene.control, 0.0015);
+  return perturbed;
+}
+
 TEST(StereoRefinement, TrueShapeIsNearlyStationary) {
   const testing::RefinementScene& scene = Scene();
   const RefinementResult result = scene.Refine(scene.scene.control, 2, TestOptions());
@@ -50,7 +57,7 @@ TEST(StereoRefinement, TrueShapeIsNearlyStationary) {
 
 TEST(StereoRefinement, PerturbedShapeMovesBackTowardsTheTruth) {
   const testing::RefinementScene& scene = Scene();
-  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const Positions& perturbed = PerturbedStart();
   const double before = scene.RmsDistanceToTruth(perturbed);
   ASSERT_GT(before, 5e-4);
   const RefinementResult result = scene.Refine(perturbed, 2, TestOptions());
@@ -72,7 +79,7 @@ TEST(StereoRefinement, PerturbedShapeMovesBackTowardsTheTruth) {
 // of the refinement.
 TEST(StereoRefinement, ReducedCorrelationBlocksTakeTheSameSteps) {
   const testing::RefinementScene& scene = Scene();
-  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const Positions& perturbed = PerturbedStart();
   StereoRefinementOptions options = TestOptions();
   options.solver.reduced_correlation_blocks = false;
   const RefinementResult full = scene.Refine(perturbed, 2, options);
@@ -108,7 +115,7 @@ TEST(StereoRefinement, LargeWindowsUseTheIterativeSolver) {
   EXPECT_TRUE(solver.ToCeres(1).IsValid(&why)) << why;
 
   const testing::RefinementScene& scene = Scene();
-  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const Positions& perturbed = PerturbedStart();
   const double before = scene.RmsDistanceToTruth(perturbed);
   StereoRefinementOptions options = TestOptions();
   options.solver.iterative_from_unknowns = 1;
@@ -151,7 +158,7 @@ StereoRefinementOptions LevelZeroOverlapOptions() {
 // the middle frame is solved in both; every frame is refined and moves back.
 TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
   const testing::RefinementScene& scene = Scene();
-  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const Positions& perturbed = PerturbedStart();
   const double before = scene.RmsDistanceToTruth(perturbed);
   StereoRefinementOptions options = LevelZeroOverlapOptions();
   const RefinementResult result = scene.Refine(perturbed, 3, options);
@@ -175,7 +182,7 @@ TEST(StereoRefinement, OverlappingWindowsRefineEveryFrame) {
 // as close to the truth as one chain of windows gets it.
 TEST(StereoRefinement, HalvesSideBySideRefineEveryFrameAsOneChainDoes) {
   const testing::RefinementScene& scene = Scene();
-  const Positions perturbed = Perturbed(scene.scene.hierarchy, scene.scene.control, 0.0015);
+  const Positions& perturbed = PerturbedStart();
   const double before = scene.RmsDistanceToTruth(perturbed);
   StereoRefinementOptions options = LevelZeroOverlapOptions();
   const RefinementResult one_chain = scene.Refine(perturbed, 6, options);
