@@ -176,6 +176,9 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
       ->capture_default_str();
   sub->add_option("--silhouette-from-level", o->silhouette_from_level,
                   "Coarsest level with outline blocks (a base-level block drags a wide region)")->capture_default_str();
+  sub->add_option("--rim-band", o->rim_band,
+                  "Draw the surface's rim onto mask outlines it lies within this many pixels of (0 = off)")
+      ->capture_default_str();
   sub->add_option("--membrane-weight", o->membrane_weight, "Spatial smoothness of the corrections")
       ->capture_default_str();
   sub->add_option("--temporal-smoothness", o->temporal_smoothness,

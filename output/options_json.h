@@ -146,7 +146,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StereoRefinementOptions, coarses
                                    normal_only_from_level, window, window_overlap, concurrent_halves, rounds, solver,
                                    samples_per_pixel, min_density, max_density, max_cameras, min_samples,
                                    image_sigma, ncc_epsilon, ncc_loss_scale, temporal_weight, silhouette_weight,
-                                   silhouette_from_level, angle_weight_power, outline_margin, membrane_weight, temporal_smoothness,
+                                   silhouette_from_level, rim_band, angle_weight_power, outline_margin, membrane_weight, temporal_smoothness,
                                    damping, max_step, adaptive_threshold, visibility)
 
 // The stages under the names of their report sections.

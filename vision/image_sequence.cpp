@@ -44,6 +44,7 @@ ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_c
   std::vector<bool> masks(dataset.camera_count());
   for (int k = 0; k < dataset.camera_count(); ++k)
     masks[k] = (evidence == EvidenceSource::kAuto ? AutomaticSource(dataset, k) : evidence) == EvidenceSource::kMask;
+  sequence.tight_outline.assign(masks.begin(), masks.end());
   sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras](int camera, int frame) {
     const Camera& working_camera = cameras[camera];
     if (masks[camera])

@@ -31,6 +31,10 @@ struct ImageSequence {
   // Silhouette, CV_8UC1 (nonzero = object), undistorted; an empty Mat, or no loader at
   // all, means none for that camera and frame.
   ImageLoader silhouette;
+  // Per camera: 1 when its silhouette is the object's own outline (a mask), so the
+  // surface's outline must reach it; 0 when it only bounds the object (a projected visual
+  // hull, which contains it). Empty: every camera's silhouette is the object's outline.
+  std::vector<char> tight_outline;
 
   int camera_count() const { return static_cast<int>(cameras.size()); }
   // Throws subflow::Error naming `stage` when there is no camera, no frame or no gray loader.
@@ -47,7 +51,7 @@ cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolatio
 // evidence (`evidence`, kAuto resolved by AutomaticSource, as shape initialization does) is
 // a mask, the dataset's mask; otherwise hulls[f] (the frame's visual hull, world
 // coordinates) rendered into the camera (ZBuffer::Mask), none when `hulls` is null or that
-// hull is empty. `working`: per camera, the working camera (vision/working_scale.h) whose
+// hull is empty; tight_outline says which. `working`: per camera, the working camera (vision/working_scale.h) whose
 // size every image is resized to before undistortion, and which the sequence's cameras
 // are; null = the stored cameras and sizes.
 ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,

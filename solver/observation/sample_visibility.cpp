@@ -77,20 +77,24 @@ geometry::TriangleMesh VisibilityTester::Tessellation(const Positions& control) 
 SampleVisibility VisibilityTester::Compute(const std::vector<vision::Camera>& cameras,
                                            const Positions& control,
                                            const Positions& sample_positions,
-                                           const Positions& sample_normals) const {
+                                           const Positions& sample_normals,
+                                           const std::vector<char>* coverage_of) const {
   SUBFLOW_CHECK(sample_positions.rows() == sample_normals.rows(), "positions and normals differ");
+  SUBFLOW_CHECK(!coverage_of || coverage_of->size() == cameras.size(), "one coverage flag per camera");
   const geometry::TriangleMesh mesh = Tessellation(control);
   SampleVisibility result;
   result.depth_tolerance = options_.depth_tolerance > 0.0 ? options_.depth_tolerance
                                                           : 0.5 * geometry::MeanEdgeLength(hierarchy_->Topology(level_), control);
   const int sample_count = static_cast<int>(sample_positions.rows());
   result.visible.assign(cameras.size(), std::vector<std::uint8_t>(sample_count, 0));
+  result.coverage.resize(cameras.size());
   tbb::parallel_for(std::size_t{0}, cameras.size(), [&](std::size_t k) {
     const vision::Camera& camera = cameras[k];
     thread_local vision::ZBuffer zbuffer;  // its buffers reused from render to render
     vision::ZBufferOptions depth_only;
     depth_only.depth_only = true;
     zbuffer.Render(camera, mesh.V, mesh.F, depth_only);
+    if (coverage_of && (*coverage_of)[k]) result.coverage[k] = zbuffer.Mask();
     const Eigen::Vector3d centre = camera.Center();
     std::vector<std::uint8_t>& visible = result.visible[k];
     for (int s = 0; s < sample_count; ++s) {

@@ -16,6 +16,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "geometry/limit_evaluation.h"
 #include "geometry/limit_tessellation.h"
 #include "geometry/loop_hierarchy.h"
@@ -45,6 +47,9 @@ struct SampleVisibility {
   // visible[k][s] = 1 when sample s is visible in camera k.
   std::vector<std::vector<std::uint8_t>> visible;
   double depth_tolerance = 0.0;  // the tolerance used (after the automatic choice)
+  // Per camera asked for (VisibilityTester::Compute's coverage_of): where the surface
+  // covers the image (CV_8UC1, 255 = covered, from the same z-buffer); else an empty Mat.
+  std::vector<cv::Mat> coverage;
 
   int camera_count() const { return static_cast<int>(visible.size()); }
   // Cameras that see sample s, in camera order.
@@ -65,11 +70,13 @@ class VisibilityTester {
 
   // Visibility of the samples (positions and unit normals #S×3, e.g. from
   // SurfaceSamples::SamplePositions / SampleNormals) for control points `control`
-  // (#V(level)×3) in every camera. Renders in parallel over cameras.
+  // (#V(level)×3) in every camera, and the surface's coverage of the cameras with
+  // coverage_of[k] (null: none). Renders in parallel over cameras.
   SampleVisibility Compute(const std::vector<vision::Camera>& cameras,
                            const geometry::Positions& control,
                            const geometry::Positions& sample_positions,
-                           const geometry::Positions& sample_normals) const;
+                           const geometry::Positions& sample_normals,
+                           const std::vector<char>* coverage_of = nullptr) const;
 
   // The tessellated limit surface for `control` (what the z-buffer renders).
   geometry::TriangleMesh Tessellation(const geometry::Positions& control) const;

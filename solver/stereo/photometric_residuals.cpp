@@ -88,6 +88,48 @@ PatchCorrelationCost* CorrelationCost(RefinementWindow& window, int face, const 
   return cost;
 }
 
+// The sample of `face` at `frame` on camera k's outline rim, or -1: the patch's samples
+// both face the camera and face away (the contour generator crosses it); of those, the one
+// nearest the contour generator (smallest |cos| between its normal and its view ray — not
+// the one projecting outermost, whose pick would favour the staircase's outward errors)
+// lies within `band` pixels inside the outline or outside it; and nothing of the frame's
+// current surface covers the image 1.5 and 2.5 px beyond it (along the projected normal) —
+// else the rim is one in front of another part (a leg before the other leg, a nose before
+// the cheek), whose outline the silhouette does not show.
+int RimSample(const RefinementWindow& window, int frame, int face, int k, const SignedDistanceImage& distance,
+              double band) {
+  const FrameState& state = window.states.at(frame);
+  const vision::Camera& camera = (*window.cameras)[k];
+  if (state.coverage.empty() || state.coverage[k].empty()) return -1;
+  const int first = window.sampling->face_first[face];
+  const int m = window.sampling->FaceSampleCount(face);
+  const Eigen::Vector3d centre = camera.Center();
+  bool facing = false, away = false;
+  int rim = -1;
+  double smallest = 2.0;
+  for (int i = 0; i < m; ++i) {
+    const Eigen::Vector3d ray = state.positions.row(first + i).transpose() - centre;
+    const double c = state.normals.row(first + i).dot(ray.transpose()) / ray.norm();
+    (c < 0 ? facing : away) = true;
+    if (std::abs(c) < smallest) smallest = std::abs(c), rim = i;
+  }
+  if (!facing || !away) return -1;
+  double depth = 0.0, value = 0.0;
+  const Eigen::Vector2d pixel = camera.ProjectUndistorted(state.positions.row(first + rim).transpose(), &depth);
+  if (depth <= 0 || !SampleScalar(distance.distance, pixel, &value) || value < -band) return -1;
+  const Eigen::Vector3d X = state.positions.row(first + rim).transpose();
+  const double step = 1e-3 * (X - centre).norm();
+  const Eigen::Vector2d out = camera.ProjectUndistorted(X + step * state.normals.row(first + rim).transpose()) - pixel;
+  if (!(out.norm() > 0)) return -1;
+  const cv::Mat& covered = state.coverage[k];
+  for (double reach : {1.5, 2.5}) {
+    const Eigen::Vector2d q = pixel + reach * out.normalized();
+    const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+    if (x >= 0 && y >= 0 && x < covered.cols && y < covered.rows && covered.at<std::uint8_t>(y, x)) return -1;
+  }
+  return rim;
+}
+
 }  // namespace
 
 PatchCameras CamerasOfPatch(const RefinementWindow& window, int frame, int face) {
@@ -188,10 +230,26 @@ void AddSilhouetteResiduals(RefinementWindow& window, int frame, int face, ceres
   const std::vector<int>& support = window.sampling->support[face];
   const PatchStencil& stencil = window.sampling->stencil[face];
   const int m = window.sampling->FaceSampleCount(face);
-  const int s = window.sampling->face_first[face] + m / 2;
-  const Eigen::Vector3d X = window.states.at(frame).positions.row(s).transpose();
+  const int first = window.sampling->face_first[face];
+  const auto add = [&](int k, int i, bool one_sided) {
+    std::vector<double*> blocks;
+    AppendBlocks(window, frame, support, &blocks);
+    auto* cost = new SilhouetteCost(distances[k].get(), &cameras[k],
+                                    window.states.at(frame).positions.row(first + i).transpose(),
+                                    stencil.row(i).transpose(), BasesOf(window, frame, support), window.dof,
+                                    options.silhouette_weight, one_sided);
+    records->push_back({problem->AddResidualBlock(cost, nullptr, blocks), frame, nullptr});
+  };
+  const Eigen::Vector3d X = window.states.at(frame).positions.row(first + m / 2).transpose();
   for (int k = 0; k < static_cast<int>(cameras.size()); ++k) {
     if (!distances[k]) continue;
+    if (options.rim_band > 0 && window.images->TightOutline(k)) {
+      const int rim = RimSample(window, frame, face, k, *distances[k], options.rim_band);
+      if (rim >= 0) {
+        add(k, rim, false);
+        continue;
+      }
+    }
     double depth = 0.0;
     const Eigen::Vector2d p = cameras[k].ProjectUndistorted(X, &depth);
     double distance = 0.0;
@@ -200,11 +258,7 @@ void AddSilhouetteResiduals(RefinementWindow& window, int frame, int face, ceres
     // a convex surface projects within 2 px of its outline in a camera, so a wider band
     // would cost many blocks for nothing.
     if (distance < -0.5) continue;
-    std::vector<double*> blocks;
-    AppendBlocks(window, frame, support, &blocks);
-    auto* cost = new SilhouetteCost(distances[k].get(), &cameras[k], X, stencil.row(m / 2).transpose(),
-                                    BasesOf(window, frame, support), window.dof, options.silhouette_weight, true);
-    records->push_back({problem->AddResidualBlock(cost, nullptr, blocks), frame, nullptr});
+    add(k, m / 2, true);
   }
 }
 

@@ -14,7 +14,14 @@
 //              patch's middle sample lies outside, on or within half a pixel of the
 //              outline: w · max(0, D(p(X))), D the signed distance (one-sided: no point is
 //              pushed outside the outline, and a sample near but not on the contour
-//              generator projects inside it, which a two-sided term would bias outwards).
+//              generator projects inside it, which a two-sided term would bias outwards);
+//   rim        instead, where the camera's silhouette is the object's own outline (a
+//              mask) and the patch straddles the camera's contour generator: w · D(p(X))
+//              at the patch's sample nearest the contour generator, two-sided, when that
+//              sample projects within rim_band pixels inside the outline (or outside) and
+//              no other part of the surface lies just beyond it in the image. What draws
+//              a surface out to the outline: the correlation stops outline_margin pixels
+//              inside it.
 #pragma once
 
 #include <optional>

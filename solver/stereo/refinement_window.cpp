@@ -40,14 +40,14 @@ const std::vector<std::unique_ptr<SignedDistanceImage>>& FrameImageCache::Silhou
   return silhouette_cache_.emplace(frame, std::move(distances)).first->second;
 }
 
-const SampleVisibilityFlags* FrameImageCache::Visibility(int frame, const Positions& control) const {
+const FrameVisibility* FrameImageCache::Visibility(int frame, const Positions& control) const {
   const auto it = visibility_cache_.find(frame);
   if (it == visibility_cache_.end() || it->second.first.rows() != control.rows() || it->second.first != control)
     return nullptr;
   return &it->second.second;
 }
 
-void FrameImageCache::KeepVisibility(int frame, const Positions& control, SampleVisibilityFlags visible) {
+void FrameImageCache::KeepVisibility(int frame, const Positions& control, FrameVisibility visible) {
   visibility_cache_[frame] = {control, std::move(visible)};
 }
 
@@ -105,11 +105,17 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& h
     if (window.active_faces[f])
       for (int k = 0; k < 3; ++k) window.active_vertices[F(f, k)] = 1;
   const int c0 = std::max(window.span_first, first - 1), c1 = std::min(window.SpanLast(), last + 1);
+  const bool rim = options.rim_band > 0 && options.silhouette_weight > 0 &&
+                   level.level >= options.silhouette_from_level;
   for (int f = c0; f <= c1; ++f) {
-    const SampleVisibilityFlags* known = images->Visibility(f, control[f]);
-    SampleVisibilityFlags decided;
+    const auto& silhouettes = images->Silhouettes(f);
+    std::vector<char> coverage_of(cameras.size(), 0);
+    for (std::size_t k = 0; rim && k < cameras.size(); ++k)
+      coverage_of[k] = silhouettes[k] && images->TightOutline(static_cast<int>(k));
+    const FrameVisibility* known = images->Visibility(f, control[f]);
+    FrameVisibility decided;
     window.states.emplace(f, MakeFrameState(hierarchy, level.level, level.dof, trajectory[f], control[f],
-                                            level.sampling, *level.visibility, cameras, images->Silhouettes(f),
+                                            level.sampling, *level.visibility, cameras, silhouettes, coverage_of,
                                             options.outline_margin, known, known ? nullptr : &decided));
     if (!known) images->KeepVisibility(f, control[f], std::move(decided));
   }
@@ -121,8 +127,8 @@ FrameState MakeFrameState(const LoopHierarchy& hierarchy, int level, int dof,
                           const LevelSampling& sampling, const VisibilityTester& tester,
                           const std::vector<vision::Camera>& cameras,
                           const std::vector<std::unique_ptr<SignedDistanceImage>>& silhouettes,
-                          double outline_margin, const SampleVisibilityFlags* known,
-                          SampleVisibilityFlags* decided) {
+                          const std::vector<char>& coverage_of, double outline_margin,
+                          const FrameVisibility* known, FrameVisibility* decided) {
   FrameState state;
   std::vector<geometry::LocalFrames> frames;
   state.level_control = shape.Synthesize(hierarchy, level, &frames);
@@ -152,8 +158,15 @@ FrameState MakeFrameState(const LoopHierarchy& hierarchy, int level, int dof,
   state.normals.resize(state.positions.rows(), 3);
   for (Eigen::Index s = 0; s < du.rows(); ++s)
     state.normals.row(s) = du.row(s).cross(dv.row(s)).normalized();
-  state.usable = known ? *known : tester.Compute(cameras, finest_control, state.positions, state.normals).visible;
-  if (decided) *decided = state.usable;
+  if (known) {
+    state.usable = known->visible;
+    state.coverage = known->coverage;
+  } else {
+    SampleVisibility computed = tester.Compute(cameras, finest_control, state.positions, state.normals, &coverage_of);
+    state.usable = std::move(computed.visible);
+    state.coverage = std::move(computed.coverage);
+    if (decided) *decided = {state.usable, state.coverage};
+  }
   tbb::parallel_for(0, static_cast<int>(cameras.size()), [&](int k) {
     if (!silhouettes[k]) return;
     for (Eigen::Index s = 0; s < state.positions.rows(); ++s) {

@@ -40,6 +40,13 @@ class ViewCache;
 // Per camera and sample: visible or not (SampleVisibility::visible).
 using SampleVisibilityFlags = std::vector<std::vector<std::uint8_t>>;
 
+// What a frame's z-buffers decided: per camera and sample, visible or not; per camera whose
+// silhouette is the object's outline (for the rim term), where the surface covers the image.
+struct FrameVisibility {
+  SampleVisibilityFlags visible;
+  std::vector<cv::Mat> coverage;  // empty Mats for the other cameras
+};
+
 // What the windows of a level share per frame: the images a window needs, smoothed (σ =
 // image_sigma), the silhouettes' signed distances, and the visibility of the level's
 // samples; each computed once and released when no later window needs it.
@@ -57,10 +64,15 @@ class FrameImageCache {
   const std::vector<SmoothedImage>& Gray(int frame);
   // Per camera: the signed distance to the silhouette's outline at `frame`, or null.
   const std::vector<std::unique_ptr<SignedDistanceImage>>& Silhouettes(int frame);
+  // Whether camera `camera`'s silhouette is the object's own outline
+  // (vision::ImageSequence::tight_outline).
+  bool TightOutline(int camera) const {
+    return images_.tight_outline.empty() || images_.tight_outline.at(camera) != 0;
+  }
   // The visibility of the current level's samples at `frame` as decided for the finest
   // control points `control`, or null when it was not (or for another shape).
-  const SampleVisibilityFlags* Visibility(int frame, const geometry::Positions& control) const;
-  void KeepVisibility(int frame, const geometry::Positions& control, SampleVisibilityFlags visible);
+  const FrameVisibility* Visibility(int frame, const geometry::Positions& control) const;
+  void KeepVisibility(int frame, const geometry::Positions& control, FrameVisibility visible);
   // Forgets every frame's visibility (a new level or round).
   void ForgetVisibility() { visibility_cache_.clear(); }
   // Forgets the frames before `first_kept`.
@@ -71,7 +83,7 @@ class FrameImageCache {
   double sigma_;
   std::map<int, std::vector<SmoothedImage>> gray_cache_;
   std::map<int, std::vector<std::unique_ptr<SignedDistanceImage>>> silhouette_cache_;
-  std::map<int, std::pair<geometry::Positions, SampleVisibilityFlags>> visibility_cache_;
+  std::map<int, std::pair<geometry::Positions, FrameVisibility>> visibility_cache_;
 };
 
 struct FrameState {
@@ -82,6 +94,10 @@ struct FrameState {
   // `outline_margin` pixels inside it: the smoothed intensity of a sample near the outline
   // mixes in the background, which biases the correlation towards shrinking the surface.
   std::vector<std::vector<std::uint8_t>> usable;
+  // Per camera whose silhouette is the object's outline (FrameImageCache::TightOutline),
+  // for the rim term: where the frame's current surface covers the image (CV_8UC1); empty
+  // for the other cameras and when the rim term is off.
+  std::vector<cv::Mat> coverage;
   std::vector<double> increments;  // e: #V(ℓ) × dof, zero at the start
 };
 
@@ -145,14 +161,15 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const geometry::LoopHi
 
 // The state of one frame at level ℓ: `shape` and `finest_control` are the frame's current
 // multires shape and finest control points; `silhouettes` its signed distances per camera.
-// The samples' visibility is `known` when given, else decided by `tester` on the current
-// shape (and then written to `decided` when given).
+// The samples' visibility (and the coverage of the cameras with coverage_of[k]) is `known`
+// when given, else decided by `tester` on the current shape (and then written to `decided`
+// when given).
 FrameState MakeFrameState(const geometry::LoopHierarchy& hierarchy, int level, int dof,
                           const geometry::MultiresShape& shape, const geometry::Positions& finest_control,
                           const LevelSampling& sampling, const VisibilityTester& tester,
                           const std::vector<vision::Camera>& cameras,
                           const std::vector<std::unique_ptr<SignedDistanceImage>>& silhouettes,
-                          double outline_margin, const SampleVisibilityFlags* known = nullptr,
-                          SampleVisibilityFlags* decided = nullptr);
+                          const std::vector<char>& coverage_of, double outline_margin,
+                          const FrameVisibility* known = nullptr, FrameVisibility* decided = nullptr);
 
 }  // namespace subflow::solver

@@ -286,6 +286,7 @@ void StereoRefinementOptions::Check() const {
               temporal_smoothness >= 0 && damping >= 0,
           "weights", "must be ≥ 0");
   require(silhouette_from_level >= 0, "silhouette_from_level", "must be ≥ 0");
+  require(rim_band >= 0, "rim_band", "must be ≥ 0 (pixels; 0 = off)");
   require(min_patch_area > 0, "min_patch_area", "must be > 0 (pixels²)");
   require(detail_threshold >= 0, "detail_threshold", "must be ≥ 0 (edge lengths; 0 = off)");
   require(min_detail_patch_area > 0, "min_detail_patch_area", "must be > 0 (pixels²)");

@@ -22,7 +22,7 @@
 //     along the surface;
 //   * silhouette: every patch's middle sample projects inside every silhouette (one-sided
 //     signed distance to the outline; masks from the dataset, else the projected visual
-//     hulls);
+//     hulls), and on a mask's outline the surface's rim lies on it (two-sided, rim_band);
 //   * regularization, in units of the level's mean edge length h: membrane on the
 //     increments (B_v e_v − mean of the neighbours), temporal second differences (of the
 //     details' trajectories in their local frames, which a rigid motion leaves unchanged,
@@ -172,6 +172,14 @@ struct StereoRefinementOptions {
   // 0.984, mug_ring 4.131 → 4.579); without masks it costs critter_nomasks 1.167 → 1.819 px.
   // Not one way better: the base level keeps its outline blocks.
   int silhouette_from_level = 0;
+  // The rim: where a patch straddles a camera's contour generator (its samples face the
+  // camera and face away) and its outermost sample projects within rim_band pixels of that
+  // camera's outline, the sample is drawn onto the outline from both sides, with
+  // silhouette_weight — only for outlines that are the object's own (masks), not for
+  // projected hulls, which only bound it. Without it nothing pulls a surface out towards
+  // the outline: correlation stops outline_margin pixels inside it and the outline term is
+  // one-sided, so grazing regions sank inwards (docs/shape.md, "The rim"). 0 = off.
+  double rim_band = 2.0;
   // Pair weight W(i, j) = (cos θ_i cos θ_j)^p: grazing views see the texture foreshortened
   // and blurred along the surface, which biases the correlation optimum.
   double angle_weight_power = 3.0;
@@ -209,7 +217,7 @@ struct RefinementFrameReport {
   // Mean NCC over the stereo pairs of all patches (ε-regularized), before and after.
   double ncc_before = 0, ncc_after = 0;
   int stereo_pairs = 0;
-  // RMS silhouette distance (pixels) of the one-sided outline term, before and after.
+  // RMS silhouette distance (pixels) of the outline and rim blocks, before and after.
   double silhouette_rms_before = 0, silhouette_rms_after = 0;
 };
 

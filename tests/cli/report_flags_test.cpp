@@ -99,6 +99,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--temporal-weight", {"0.5", "/options/refinement/temporal_weight", 0.5}},
       {"--silhouette-weight", {"0.1", "/options/refinement/silhouette_weight", 0.1}},
       {"--silhouette-from-level", {"2", "/options/refinement/silhouette_from_level", 2}},
+      {"--rim-band", {"1.5", "/options/refinement/rim_band", 1.5}},
       {"--membrane-weight", {"0.2", "/options/refinement/membrane_weight", 0.2}},
       {"--temporal-smoothness", {"0.2", "/options/refinement/temporal_smoothness", 0.2}},
   };

@@ -197,7 +197,7 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
                             truth.back().v).transpose();
     fitted.push_back(next);
   }
-  vision::ImageSequence images_of_frames{scene.cameras, 0, 3, [&](int camera, int frame) { return images[frame][camera]; }, {}};
+  vision::ImageSequence images_of_frames{scene.cameras, 0, 3, [&](int camera, int frame) { return images[frame][camera]; }, {}, {}};
   MotionInitOptions init;
   const MotionInitResult result = InitializeMotion(images_of_frames, scene.hierarchy, fitted, 1, init);
   ASSERT_EQ(result.control.size(), 3u);
@@ -251,7 +251,7 @@ TEST(MotionInit, FlagsADuplicatedFrameAndKeepsTheSurfaceStill) {
   const std::vector<cv::Mat> second = testing::RenderGray(scene, sequence.frames[1]);
   const vision::ImageSequence images{scene.cameras, 0, 3, [&](int camera, int frame) {
                                        return frame == 0 ? first[camera] : second[camera].clone();
-                                     }, {}};
+                                     }, {}, {}};
   const MotionInitResult result = InitializeMotion(images, scene.hierarchy, {scene.control}, 0, MotionInitOptions());
   ASSERT_EQ(result.control.size(), 3u);
   EXPECT_FALSE(result.frames[0].identical_images);  // the reference frame
@@ -268,7 +268,7 @@ TEST(MotionInit, FlagsADuplicatedFrameAndKeepsTheSurfaceStill) {
 
 TEST(MotionInit, RejectsInconsistentInputs) {
   const MotionTestScene& scene = Scene();
-  const vision::ImageSequence images{scene.cameras, 0, 3, [](int, int) { return cv::Mat(); }, {}};
+  const vision::ImageSequence images{scene.cameras, 0, 3, [](int, int) { return cv::Mat(); }, {}, {}};
   const MotionInitOptions options;
   EXPECT_THROW(InitializeMotion(images, scene.hierarchy, {scene.control}, 3, options),
                Error);

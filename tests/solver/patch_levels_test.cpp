@@ -136,6 +136,11 @@ TEST(PatchLevels, LargeDetailsAreRefinedBelowTheAreaFloorOnlyWhereTheyAre) {
   options.adaptive_threshold = 0.0;
   options.detail_threshold = 0.01;
   options.solver.max_iterations = 4;
+  // The rim term acts along the outlines wherever a level is refined, which level 1
+  // everywhere reaches and the dent's level 1 does not; it has its own tests
+  // (stereo_refinement_test.cpp). Off, so that the dent alone is compared (with it: level
+  // 0 only 0.132 mm, the dent's level 1 0.081 mm, level 1 everywhere 0.074 mm).
+  options.rim_band = 0.0;
   // A 3 mm dent facing the cameras (the potato's radius is 0.1, the base edges ~0.03).
   const Eigen::Vector3d towards(0.3, -1.0, 0.6);
   const geometry::Positions dented = Dented(scene.hierarchy, scene.control, 3e-3, towards);

@@ -45,7 +45,7 @@ struct RefinementScene {
   vision::ImageSequence Sequence(int frames, const std::vector<cv::Mat>* silhouettes = nullptr) const {
     const std::vector<cv::Mat>& chosen = silhouettes ? *silhouettes : masks;
     return {scene.cameras, 0, frames, [this](int camera, int) { return images[camera]; },
-            [&chosen](int camera, int) { return chosen[camera]; }};
+            [&chosen](int camera, int) { return chosen[camera]; }, {}};
   }
   // RMS distance of the limit surface of `control` to the true limit surface.
   double RmsDistanceToTruth(const Positions& control) const {
