@@ -93,9 +93,10 @@ PatchCorrelationCost* CorrelationCost(RefinementWindow& window, int face, const 
 // nearest the contour generator (smallest |cos| between its normal and its view ray — not
 // the one projecting outermost, whose pick would favour the staircase's outward errors)
 // lies within `band` pixels inside the outline or outside it; and nothing of the frame's
-// current surface covers the image 1.5 and 2.5 px beyond it (along the projected normal) —
-// else the rim is one in front of another part (a leg before the other leg, a nose before
-// the cheek), whose outline the silhouette does not show.
+// current surface covers the image 1 and 2 px beyond it (along the projected normal): the
+// rim is the current surface's outline, not one in front of another part (a leg before the
+// other leg, a nose before the cheek) or inside a bridge over a hollow, whose outline the
+// silhouette does not show.
 int RimSample(const RefinementWindow& window, int frame, int face, int k, const SignedDistanceImage& distance,
               double band) {
   const FrameState& state = window.states.at(frame);
@@ -122,7 +123,7 @@ int RimSample(const RefinementWindow& window, int frame, int face, int k, const 
   const Eigen::Vector2d out = camera.ProjectUndistorted(X + step * state.normals.row(first + rim).transpose()) - pixel;
   if (!(out.norm() > 0)) return -1;
   const cv::Mat& covered = state.coverage[k];
-  for (double reach : {1.5, 2.5}) {
+  for (double reach : {1.0, 2.0}) {
     const Eigen::Vector2d q = pixel + reach * out.normalized();
     const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
     if (x >= 0 && y >= 0 && x < covered.cols && y < covered.rows && covered.at<std::uint8_t>(y, x)) return -1;
