@@ -146,6 +146,20 @@ void Warn(CarvingResult* result, const std::string& message, spdlog::level::leve
   result->warnings.push_back(message);
 }
 
+// The automatic values, by the used cameras' evidence: max_misses 1 when some silhouette
+// comes from motion, else 0; closing and opening radii 0 when every one is a mask, else 1.
+void ResolveBySources(const std::vector<CarvingCamera>& used, const std::vector<Silhouette>& silhouettes,
+                      const VoxelCarvingOptions& options, CarvingResult* result) {
+  bool any_motion = false, all_masks = true;
+  for (const CarvingCamera& c : used) {
+    any_motion = any_motion || silhouettes[c.index].source == EvidenceSource::kMotion;
+    all_masks = all_masks && silhouettes[c.index].source == EvidenceSource::kMask;
+  }
+  result->max_misses = options.max_misses >= 0 ? options.max_misses : (any_motion ? 1 : 0);
+  result->closing_radius = options.closing_radius >= 0 ? options.closing_radius : (all_masks ? 0 : 1);
+  result->opening_radius = options.opening_radius >= 0 ? options.opening_radius : (all_masks ? 0 : 1);
+}
+
 }  // namespace
 
 const char* const kBorderSides[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
@@ -183,8 +197,8 @@ void VoxelCarvingOptions::Check() const {
   if (max_misses < -1) fail("max_misses", "-1 (automatic) or ≥ 0", max_misses);
   if (!(evidence_threshold > 0 && evidence_threshold <= 1)) fail("evidence_threshold", "a value in (0, 1]", evidence_threshold);
   if (!(footprint_margin >= 0 && footprint_margin <= 100)) fail("footprint_margin", "a value in [0, 100] pixels", footprint_margin);
-  if (closing_radius < 0 || closing_radius > 32) fail("closing_radius", "0..32 voxels", closing_radius);
-  if (opening_radius < 0 || opening_radius > 32) fail("opening_radius", "0..32 voxels", opening_radius);
+  if (closing_radius < -1 || closing_radius > 32) fail("closing_radius", "-1 (automatic) or 0..32 voxels", closing_radius);
+  if (opening_radius < -1 || opening_radius > 32) fail("opening_radius", "-1 (automatic) or 0..32 voxels", opening_radius);
   if (connectivity != 6 && connectivity != 26) fail("connectivity", "6 or 26", connectivity);
   if (!(min_component_fraction >= 0 && min_component_fraction <= 1)) fail("min_component_fraction", "a value in [0, 1]", min_component_fraction);
   if (threads < 0) fail("threads", "0 (all) or a positive count", threads);
@@ -221,7 +235,9 @@ VoxelCarvingOptions ResolveCarvingOptions(const std::vector<Camera>& cameras, co
   const double spacing = bounds.Size().maxCoeff() / resolved.resolution;
   if (automatic > 0 && spacing > automatic) {
     const auto narrow = [&](int radius) {
-      return std::min(radius, static_cast<int>(std::floor(radius * automatic / spacing + 0.5)));
+      const auto narrowed = [&](int r) { return std::min(r, static_cast<int>(std::floor(r * automatic / spacing + 0.5))); };
+      // Automatic stays automatic unless even its largest choice (1) narrows to 0.
+      return radius >= 0 ? narrowed(radius) : (narrowed(1) >= 1 ? -1 : 0);
     };
     resolved.closing_radius = narrow(options.closing_radius);
     resolved.opening_radius = narrow(options.opening_radius);
@@ -297,11 +313,7 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
     ThrowError(where, "cameras", "only " + std::to_string(used.size()) +
                                      " camera(s) usable, min_cameras = " + std::to_string(options.min_cameras));
 
-  bool any_motion = false;
-  for (const CarvingCamera& c : used) any_motion = any_motion || silhouettes[c.index].source == EvidenceSource::kMotion;
-  result.max_misses = options.max_misses >= 0 ? options.max_misses : (any_motion ? 1 : 0);
-  result.closing_radius = options.closing_radius;
-  result.opening_radius = options.opening_radius;
+  ResolveBySources(used, silhouettes, options, &result);
   result.resolution = ChooseResolution(cameras, bounds, options);
   result.occupancy = MakeVoxelGrid(bounds, result.resolution);
   ScalarVolume& occupancy = result.occupancy;
@@ -315,8 +327,8 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
     for (size_t v = 0; v < occupancy.size(); ++v)
       occupied.values[v] = hits[v] >= options.min_cameras && misses[v] <= result.max_misses;
     result.carved_voxels = occupied.Count();
-    CloseBox(&occupied, options.closing_radius);
-    OpenBox(&occupied, options.opening_radius);
+    CloseBox(&occupied, result.closing_radius);
+    OpenBox(&occupied, result.opening_radius);
     const ComponentSummary components =
         KeepLargeComponents(&occupied, options.min_component_fraction, options.connectivity);
     result.components_found = components.found;

@@ -99,8 +99,14 @@ struct VoxelCarvingOptions {
   double footprint_margin = 0.5;
   // Radius (voxels) of the closing, then of the opening (box (2r + 1)³); 0 = skip. These
   // are the radii on the automatic grid; ResolveCarvingOptions narrows them on a coarser one.
-  int closing_radius = 1;
-  int opening_radius = 1;
+  // −1 = automatic: 0 when every used camera's evidence is a mask, 1 otherwise. The
+  // cleaning is for measured silhouettes (background differences, motion, stills: specks,
+  // bites); on masks it only removes thin parts (a 3 mm ear plate on 2.8 mm voxels) and
+  // bridges narrow gaps (between legs), and without it the refined surfaces of the mask
+  // scenes are as accurate or better and more complete (docs/shape.md, "Cleaning the hull
+  // only where the silhouettes are measured").
+  int closing_radius = -1;
+  int opening_radius = -1;
   // Connectivity of occupied voxels for components (6 or 26); empty space uses the other.
   int connectivity = 26;
   // Components with fewer voxels than this fraction of the largest are removed.
@@ -138,7 +144,7 @@ struct CarvingResult {
   geometry::ScalarVolume occupancy;  // 0 / 1 per voxel, after cleaning
   int resolution = 0;                // voxels along the longest axis
   int max_misses = 0;                // the value used (after "automatic")
-  int closing_radius = 0, opening_radius = 0;  // the radii used (voxels)
+  int closing_radius = 0, opening_radius = 0;  // the radii used (voxels, after "automatic")
   std::size_t carved_voxels = 0;     // occupied straight after carving
   std::size_t occupied_voxels = 0;   // occupied after cleaning
   int components_found = 0, components_kept = 0;

@@ -359,9 +359,10 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   const std::vector<vision::Camera> evidence_cameras = vision::ScaledCameras(dataset.cameras(), result.evidence_scales);
   std::string scales;
   for (double scale : result.evidence_scales) scales += fmt::format("{}{:.3f}", scales.empty() ? "" : " ", scale);
+  const auto radius = [](int r) { return r < 0 ? std::string("automatic") : std::to_string(r); };
   spdlog::info("evidence images at {} of the stored size (voxels of {:.4g}, {} along the longest axis; closing "
                "and opening radii {} and {})",
-               scales, voxel_size, carving.resolution, carving.closing_radius, carving.opening_radius);
+               scales, voxel_size, carving.resolution, radius(carving.closing_radius), radius(carving.opening_radius));
 
   // Without masks and background images: backgrounds estimated from the video.
   Stopwatch estimate_start;
