@@ -115,10 +115,10 @@ int RimSample(const RefinementWindow& window, int frame, int face, int k, const 
     if (std::abs(c) < smallest) smallest = std::abs(c), rim = i;
   }
   if (!facing || !away) return -1;
-  double depth = 0.0, value = 0.0;
-  const Eigen::Vector2d pixel = camera.ProjectUndistorted(state.positions.row(first + rim).transpose(), &depth);
-  if (depth <= 0 || !SampleScalar(distance.distance, pixel, &value) || value < -band) return -1;
   const Eigen::Vector3d X = state.positions.row(first + rim).transpose();
+  double depth = 0.0, value = 0.0;
+  const Eigen::Vector2d pixel = camera.ProjectUndistorted(X, &depth);
+  if (depth <= 0 || !SampleScalar(distance.distance, pixel, &value) || value < -band) return -1;
   const double step = 1e-3 * (X - centre).norm();
   const Eigen::Vector2d out = camera.ProjectUndistorted(X + step * state.normals.row(first + rim).transpose()) - pixel;
   if (!(out.norm() > 0)) return -1;

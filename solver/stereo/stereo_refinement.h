@@ -173,10 +173,11 @@ struct StereoRefinementOptions {
   // Not one way better: the base level keeps its outline blocks.
   int silhouette_from_level = 0;
   // The rim: where a patch straddles a camera's contour generator (its samples face the
-  // camera and face away) and its outermost sample projects within rim_band pixels of that
-  // camera's outline, the sample is drawn onto the outline from both sides, with
-  // silhouette_weight — only for outlines that are the object's own (masks), not for
-  // projected hulls, which only bound it. Without it nothing pulls a surface out towards
+  // camera and face away) and its sample nearest the contour generator projects within
+  // rim_band pixels inside that camera's outline (or outside it), with nothing of the
+  // surface just beyond it in the image, that sample is drawn onto the outline from both
+  // sides, with silhouette_weight — only for outlines that are the object's own (masks),
+  // not for projected hulls, which only bound it. Without it nothing pulls a surface out towards
   // the outline: correlation stops outline_margin pixels inside it and the outline term is
   // one-sided, so grazing regions sank inwards (docs/shape.md, "The rim"). 0 = off.
   double rim_band = 2.0;

@@ -216,19 +216,13 @@ TEST(SilhouetteResiduals, OnlyWhereThePatchReachesTheOutline) {
 // (blocks with negative residuals, of about the shrinkage) only by the rim term; the
 // one-sided term alone leaves it where it is, and so does the rim term where the
 // silhouettes only bound the object (projected hulls), or where the surface covers the
-// image beyond the rim. On the true surface the blocks pull
-// both ways by a fraction of a pixel (picking the rim sample that projects outermost
+// image beyond the rim. On the true surface the blocks pull both ways by a fraction of a
+// pixel (picking the rim sample that projects outermost
 // instead gave 11 inward and 336 outward blocks there, 0.32 px on average).
 TEST(SilhouetteResiduals, RimIsDrawnOntoMaskOutlinesFromBothSides) {
   const double weight = StereoRefinementOptions().silhouette_weight;
   EXPECT_GT(StereoRefinementOptions().rim_band, 0.0);
-  const Positions& truth = Scene().scene.control;
-  const Eigen::RowVector3d centre = truth.colwise().mean();
-  const double radius = (truth.rowwise() - centre).rowwise().norm().mean();
-  const double shrink = 1.5 * 0.6 / Scene().scene.cameras[0].K()(0, 0);  // ≈ 1.5 px at 0.6 m
-  Positions shrunk = truth;
-  for (Eigen::Index v = 0; v < shrunk.rows(); ++v)
-    shrunk.row(v) = centre + (truth.row(v) - centre) * (1.0 - shrink / radius);
+  const Positions shrunk = testing::Shrunk(Scene(), 1.5);
 
   const auto negatives = [](const std::vector<double>& residuals, double* mean) {
     int count = 0;

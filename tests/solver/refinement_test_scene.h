@@ -94,6 +94,19 @@ struct OpenedWindow {
   OpenedWindow(const OpenedWindow&) = delete;
 };
 
+// The scene's control points scaled about their centroid so that the surface moves
+// inwards by about `pixels` pixels at 0.6 m (where the cameras are).
+inline Positions Shrunk(const RefinementScene& refinement, double pixels) {
+  const Positions& truth = refinement.scene.control;
+  const Eigen::RowVector3d centre = truth.colwise().mean();
+  const double radius = (truth.rowwise() - centre).rowwise().norm().mean();
+  const double shrink = pixels * 0.6 / refinement.scene.cameras[0].K()(0, 0);
+  Positions shrunk = truth;
+  for (Eigen::Index v = 0; v < shrunk.rows(); ++v)
+    shrunk.row(v) = centre + (truth.row(v) - centre) * (1.0 - shrink / radius);
+  return shrunk;
+}
+
 // Smooth normal bumps on the level-1 details (about one pixel: 1.4 mm at 0.6 m).
 inline Positions Perturbed(const geometry::LoopHierarchy& hierarchy, const Positions& control, double amplitude) {
   geometry::MultiresShape shape = geometry::MultiresShape::Analyze(hierarchy, control);

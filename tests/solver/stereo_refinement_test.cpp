@@ -79,13 +79,7 @@ TEST(StereoRefinement, PerturbedShapeMovesBackTowardsTheTruth) {
 // correlation stops outline_margin pixels short (0.58 mm).
 TEST(StereoRefinement, RimDrawsAShrunkSurfaceBackToTheOutline) {
   const testing::RefinementScene& scene = Scene();
-  const Positions& truth = scene.scene.control;
-  const Eigen::RowVector3d centre = truth.colwise().mean();
-  const double radius = (truth.rowwise() - centre).rowwise().norm().mean();
-  const double shrink = 1.5 * 0.6 / scene.scene.cameras[0].K()(0, 0);
-  Positions shrunk = truth;
-  for (Eigen::Index v = 0; v < shrunk.rows(); ++v)
-    shrunk.row(v) = centre + (truth.row(v) - centre) * (1.0 - shrink / radius);
+  const Positions shrunk = testing::Shrunk(scene, 1.5);
   ASSERT_GT(scene.RmsDistanceToTruth(shrunk), 1.5e-3);
   StereoRefinementOptions no_rim = TestOptions();
   no_rim.rim_band = 0.0;

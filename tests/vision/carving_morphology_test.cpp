@@ -3,6 +3,7 @@
 // against the automatic one, and a thin part that a 3-voxel opening would remove kept.
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -34,6 +35,14 @@ cv::Mat SphereWithRodMask(const Camera& camera, const Sphere& sphere, const Eige
       }
     }
   return mask;
+}
+
+// The points of the rod's axis (x = 0.03 … 0.12 every 1 cm, off the sphere) inside the
+// carved hull's iso-surface at ½, and how many were tested.
+std::pair<int, int> RodAxisOccupied(const CarvingResult& result) {
+  int occupied = 0, total = 0;
+  for (double x = 0.03; x <= 0.12; x += 0.01, ++total) occupied += TrilinearOccupancy(result.occupancy, {x, 0, 0}) >= 0.5;
+  return {occupied, total};
 }
 
 TEST(VoxelCarving, MorphologyIsNarrowedOnlyOnGridsCoarserThanTheAutomaticOne) {
@@ -88,19 +97,14 @@ TEST(VoxelCarving, ThinPartOnACoarseGridSurvivesTheResolvedMorphology) {
   options.compute_silhouette_iou = false;
   const VoxelCarvingOptions resolved = ResolveCarvingOptions(cameras, kBounds, options);
   ASSERT_EQ(resolved.opening_radius, 0);
-  const auto rod_voxels_occupied = [&](const CarvingResult& result) {
-    int occupied = 0, total = 0;
-    for (double x = 0.03; x <= 0.12; x += 0.01, ++total) occupied += TrilinearOccupancy(result.occupancy, {x, 0, 0}) >= 0.5;
-    return std::make_pair(occupied, total);
-  };
   const CarvingResult kept = CarveVoxels(cameras, silhouettes, kBounds, resolved);
-  const auto [kept_on_axis, axis_points] = rod_voxels_occupied(kept);
+  const auto [kept_on_axis, axis_points] = RodAxisOccupied(kept);
   EXPECT_EQ(kept_on_axis, axis_points) << "points of the rod's axis outside the hull carved with the resolved options";
   EXPECT_GE(TrilinearOccupancy(kept.occupancy, sphere.centre), 0.5);
   EXPECT_EQ(kept.opening_radius, 0);
   // The same grid with the box sized for the automatic grid: the rod is gone.
   const CarvingResult opened = CarveVoxels(cameras, silhouettes, kBounds, options);
-  const auto [opened_on_axis, unused] = rod_voxels_occupied(opened);
+  const auto [opened_on_axis, unused] = RodAxisOccupied(opened);
   EXPECT_LE(opened_on_axis, 2) << "the 3-voxel opening was expected to remove the 2-voxel rod";
   EXPECT_EQ(opened.opening_radius, 1);
   std::printf("[ figures ] rod axis points occupied: %d of %d with the resolved morphology, %d with radius 1\n",
@@ -128,22 +132,17 @@ TEST(VoxelCarving, OnlyMeasuredSilhouettesAreCleanedAutomatically) {
   EXPECT_EQ(options.closing_radius, -1);
   EXPECT_EQ(options.opening_radius, -1);
   const VoxelCarvingOptions resolved = ResolveCarvingOptions(cameras, kBounds, options);
-  const auto rod_on_axis = [&](const CarvingResult& result) {
-    int occupied = 0;
-    for (double x = 0.03; x <= 0.12; x += 0.01) occupied += TrilinearOccupancy(result.occupancy, {x, 0, 0}) >= 0.5;
-    return occupied;
-  };
   const CarvingResult of_masks = CarveVoxels(cameras, masks, kBounds, resolved);
   const CarvingResult of_measured = CarveVoxels(cameras, measured, kBounds, resolved);
   EXPECT_EQ(of_masks.closing_radius, 0);
   EXPECT_EQ(of_masks.opening_radius, 0);
   EXPECT_EQ(of_measured.closing_radius, 1);
   EXPECT_EQ(of_measured.opening_radius, 1);
-  EXPECT_GE(rod_on_axis(of_masks), 9);
-  EXPECT_LE(rod_on_axis(of_measured), 2);
+  EXPECT_GE(RodAxisOccupied(of_masks).first, 9);
+  EXPECT_LE(RodAxisOccupied(of_measured).first, 2);
   EXPECT_GE(TrilinearOccupancy(of_measured.occupancy, sphere.centre), 0.5);
   std::printf("[ figures ] rod axis points occupied: %d of 10 from masks, %d from the same outlines measured\n",
-              rod_on_axis(of_masks), rod_on_axis(of_measured));
+              RodAxisOccupied(of_masks).first, RodAxisOccupied(of_measured).first);
 }
 
 }  // namespace
