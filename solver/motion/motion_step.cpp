@@ -20,6 +20,15 @@ std::vector<SmoothedImage> SmoothAll(const std::vector<cv::Mat>& images, double 
   return smoothed;
 }
 
+// The images the constraints are written on: LogHighPass of each (σ > 0), else as given.
+std::vector<cv::Mat> Structure(const std::vector<cv::Mat>& images, double highpass_sigma) {
+  if (highpass_sigma <= 0.0) return images;
+  std::vector<cv::Mat> structure(images.size());
+  tbb::parallel_for(std::size_t{0}, images.size(),
+                    [&](std::size_t k) { structure[k] = LogHighPass(images[k], highpass_sigma); });
+  return structure;
+}
+
 double Rms(const Eigen::VectorXd& values) {
   return values.size() > 0 ? std::sqrt(values.squaredNorm() / values.size()) : 0.0;
 }
@@ -35,6 +44,8 @@ void MotionStepOptions::Check() const {
   for (double sigma : image_sigmas)
     if (!std::isfinite(sigma) || sigma < 0.0 || sigma > 20.0)
       ThrowError("motion step", "image_sigmas", "expected values in [0, 20] pixels");
+  if (!std::isfinite(highpass_sigma) || highpass_sigma < 0.0 || highpass_sigma > 20.0)
+    ThrowError("motion step", "highpass_sigma", "expected a value in [0, 20] pixels (0 = off)");
 }
 
 MotionStepEstimator::MotionStepEstimator(const geometry::LoopHierarchy& hierarchy,
@@ -86,10 +97,12 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
     sample_motion = solver_.SampleMotion(*guess);
   }
   const int passes = static_cast<int>(options_.image_sigmas.size());
+  const std::vector<cv::Mat> structure_before = Structure(before, options_.highpass_sigma);
+  const std::vector<cv::Mat> structure_after = Structure(after, options_.highpass_sigma);
   std::vector<SmoothedImage> smoothed_before, smoothed_after;
   for (int pass = 0; pass < passes; ++pass) {
-    smoothed_before = SmoothAll(before, options_.image_sigmas[pass]);
-    smoothed_after = SmoothAll(after, options_.image_sigmas[pass]);
+    smoothed_before = SmoothAll(structure_before, options_.image_sigmas[pass]);
+    smoothed_after = SmoothAll(structure_after, options_.image_sigmas[pass]);
     if (pass == 0 && guess) {
       // The guess is a start, not a given: where it matches the images worse than no motion
       // does (trajectories that jump from frame to frame), the step starts from zero.

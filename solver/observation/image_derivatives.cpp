@@ -63,6 +63,14 @@ cv::Mat GrayFloat(const cv::Mat& image) {
   return result;
 }
 
+cv::Mat LogHighPass(const cv::Mat& image, double sigma) {
+  if (!std::isfinite(sigma) || sigma <= 0.0)
+    ThrowError("image derivatives", "high-pass sigma", "expected a finite value > 0 (pixels)");
+  cv::Mat log_intensity;
+  cv::log(GrayFloat(image) + static_cast<float>(kLogEpsilon), log_intensity);
+  return log_intensity - Smooth(log_intensity, sigma);
+}
+
 SmoothedImage SmoothImage(const cv::Mat& image, double sigma) {
   if (!std::isfinite(sigma) || sigma < 0.0)
     ThrowError("image derivatives", "sigma", "expected a finite value ≥ 0 (pixels)");

@@ -81,6 +81,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--no-shadow-test", {"", "/options/shape_init/silhouettes/background_shadow_test", false}},
       {"--concavities", {"", "/options/shape_init/concavities/enabled", true}},
       {"--motion-smoothness", {"0.004", "/options/motion_init/step/solver/smoothness", 0.004}},
+      {"--motion-highpass", {"0.7", "/options/motion_init/step/highpass_sigma", 0.7}},
       {"--hull-weight", {"0.4", "/options/motion_init/hull_weight", 0.4}},
       {"--refine-from", {"1", "/options/refinement/coarsest_level", 1}},
       {"--refine-to", {"1", "/options/refinement/finest_level", 1}},
