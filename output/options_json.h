@@ -134,7 +134,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalFlowSolverOptions, smoothn
                                                 cg_reweighting_tolerance, cg_max_iterations, multigrid,
                                                 multigrid_min_vertices)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionStepOptions, sampling, visibility, solver, image_sigmas,
-                                                highpass_sigma)
+                                                highpass_sigma, first_highpass_sigma)
 // WITH_DEFAULT below too.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,
                                                 hull_iterations, registration, guess_from_targets,

@@ -1,5 +1,6 @@
 #include "solver/motion/motion_step.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -46,6 +47,8 @@ void MotionStepOptions::Check() const {
       ThrowError("motion step", "image_sigmas", "expected values in [0, 20] pixels");
   if (!std::isfinite(highpass_sigma) || highpass_sigma < 0.0 || highpass_sigma > 20.0)
     ThrowError("motion step", "highpass_sigma", "expected a value in [0, 20] pixels (0 = off)");
+  if (!std::isfinite(first_highpass_sigma) || first_highpass_sigma < 0.0 || first_highpass_sigma > 100.0)
+    ThrowError("motion step", "first_highpass_sigma", "expected a value in [0, 100] pixels");
 }
 
 MotionStepEstimator::MotionStepEstimator(const geometry::LoopHierarchy& hierarchy,
@@ -97,12 +100,15 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
     sample_motion = solver_.SampleMotion(*guess);
   }
   const int passes = static_cast<int>(options_.image_sigmas.size());
-  const std::vector<cv::Mat> structure_before = Structure(before, options_.highpass_sigma);
-  const std::vector<cv::Mat> structure_after = Structure(after, options_.highpass_sigma);
   std::vector<SmoothedImage> smoothed_before, smoothed_after;
   for (int pass = 0; pass < passes; ++pass) {
-    smoothed_before = SmoothAll(structure_before, options_.image_sigmas[pass]);
-    smoothed_after = SmoothAll(structure_after, options_.image_sigmas[pass]);
+    // The first of several passes on a coarser high-pass: its wider linear range brings a
+    // motion of a few pixels within the fine structure's.
+    const double highpass = pass == 0 && passes > 1 && options_.highpass_sigma > 0.0
+                                ? std::max(options_.highpass_sigma, options_.first_highpass_sigma)
+                                : options_.highpass_sigma;
+    smoothed_before = SmoothAll(Structure(before, highpass), options_.image_sigmas[pass]);
+    smoothed_after = SmoothAll(Structure(after, highpass), options_.image_sigmas[pass]);
     if (pass == 0 && guess) {
       // The guess is a start, not a given: where it matches the images worse than no motion
       // does (trajectories that jump from frame to frame), the step starts from zero.

@@ -41,12 +41,15 @@ struct MotionStepOptions {
   // Gaussian σ in pixels, one per pass (re-linearization); at least one.
   std::vector<double> image_sigmas = {1.5, 1.0};
   // σ (pixels) of LogHighPass applied to both images before the passes; 0 = the
-  // intensities themselves. Off by default: at 0.7 px it improves the flow's end-point
-  // error on every rendered scene (blob, bust, critter, pair, mug, take_small: 2–31 %) and
-  // holds an exposure change, but its linear range is narrow — a 5 px translation from zero
-  // is lost (95.7 % sample error, 3.8 % on the intensities) — and a first pass on the
-  // intensities gives the gain back (docs/shape.md, "Motion on the images' fine structure").
+  // intensities themselves. The first of several passes uses max(highpass_sigma,
+  // first_highpass_sigma): on the fine structure alone a 5 px translation from zero is lost
+  // (95.7 % sample error; 12.8 % with the coarse first pass, 3.8 % on the intensities),
+  // and a first pass on the intensities gives up the invariance to an exposure change.
+  // Off by default: at 0.7 px the flow's end-point error falls on every rendered scene
+  // (2–31 %), but it was not yet measured on a real take (docs/shape.md, "Motion on the
+  // images' fine structure").
   double highpass_sigma = 0.0;
+  double first_highpass_sigma = 8.0;
 
   void Check() const;  // throws subflow::Error naming the field
 };
