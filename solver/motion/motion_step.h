@@ -8,7 +8,8 @@
 //   2. Visibility of the samples at the current shape (z-buffer, normal, image margin).
 //   3. Optionally (highpass_sigma > 0) brightness constancy is written on the images' fine
 //      structure, LogHighPass (image_derivatives.h): the log intensities minus their blur,
-//      invariant to a gain (exposure, flicker) and to slowly varying shading.
+//      invariant to a gain (exposure, flicker) and to slowly varying shading; the first of
+//      several passes on a coarser one (first_highpass_sigma), for its wider linear range.
 //   4. Passes p = 0 … P−1 with Gaussian σ_p = image_sigmas[p] (coarse to fine in image
 //      scale): smooth both images, build the step constraints at the current guess u = L ∂c
 //      (re-linearization / warping, normal_flow_constraints.h), solve for the total

@@ -40,8 +40,8 @@ cv::Mat GrayFloat(const cv::Mat& image);
 // kLogEpsilon, G_σ the Gaussian of the file comment), CV_32FC1. A gain (exposure, a light's
 // strength) is an offset of log I and goes; shading that varies smoothly across the image
 // goes where it is locally linear; the texture's fine detail stays. Brightness constancy on
-// it holds through an exposure change (solver/motion/motion_step.h, highpass_sigma). Throws subflow::Error for σ ≤ 0 or
-// an unsupported image.
+// it holds through an exposure change (solver/motion/motion_step.h, highpass_sigma).
+// Throws subflow::Error for σ ≤ 0 or an unsupported image.
 inline constexpr double kLogEpsilon = 0.02;
 cv::Mat LogHighPass(const cv::Mat& image, double sigma);
 

@@ -170,9 +170,9 @@ TEST(MotionStep, RecoversAKnownSmallRotation) {
 
 // A camera whose exposure changes between two frames (auto exposure, mains flicker on a fast
 // shutter): every pixel of the second image is 12 % brighter. On the intensities that change
-// reads as motion; on the images' fine structure (LogHighPass, the default), where a gain is
-// an offset that the high-pass removes, the step recovers the motion as without the change
-// (highpass_sigma 0.7, the σ measured best on the scenes; off by default, see motion_step.h).
+// reads as motion; on the images' fine structure (LogHighPass with highpass_sigma 0.7, the σ
+// measured best on the scenes; the option is off by default, see motion_step.h), where a gain
+// is an offset that the high-pass removes, the step recovers the motion as without the change.
 TEST(MotionStep, AnExposureChangeIsNotTakenForMotion) {
   const MotionTestScene& scene = Scene();
   RigidTransform motion;
