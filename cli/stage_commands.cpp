@@ -2,7 +2,7 @@
 //   subflow shape   DATASET --out S [--frames A:B] [shape options]     (also: hull)
 //   subflow motion  DATASET --from S --out M [--frames A:B] [motion options]
 //   subflow refine  DATASET --from M --out R [--frames A:B] [refinement options]
-//   subflow retrack DATASET --from R --out T [--frames A:B] [motion options, --retrack-weight]
+//   subflow retrack DATASET --from R --out T [--frames A:B] [motion options, --retrack-weight, --retrack-highpass]
 //   subflow split   DATASET --from T --out RESULT                      (the OUTPUT.md result)
 //   subflow merge   FOLDER... --out DIR     (stage folders of frame ranges → one)
 // Each runs output::RunStage, as reconstruct does.
@@ -97,12 +97,11 @@ Command AddStageCommand(CLI::App& app, solver::Stage stage, const std::string& n
       AddShapeInitOptions(sub, &arguments->options.shape, &arguments->evidence);
       break;
     case solver::Stage::kRetrack:
-      sub->add_option("--retrack-weight", arguments->options.retrack_weight,
-                      "Blend of the motion pass towards each frame's refined surface (0..1)")
-          ->capture_default_str();
-      [[fallthrough]];
+      AddRetrackOptions(sub, &arguments->options);
+      AddMotionInitOptions(sub, &arguments->options.motion, false);
+      break;
     case solver::Stage::kMotion:
-      AddMotionInitOptions(sub, &arguments->options.motion);
+      AddMotionInitOptions(sub, &arguments->options.motion, true);
       break;
     case solver::Stage::kRefine:
       AddRefinementOptions(sub, &arguments->options.refinement);

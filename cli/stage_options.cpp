@@ -112,14 +112,15 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
                 "vision/concavity_carving.h; off by default, see docs/shape.md)");
 }
 
-void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o) {
+void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o, bool first_pass) {
   sub->add_option("--motion-smoothness", o->step.solver.smoothness,
                   "Smoothness weight of the normal-flow solver (aperture problem)")->capture_default_str();
-  sub->add_option("--motion-highpass", o->step.highpass_sigma,
-                  "Motion on the log intensities minus their blur of this sigma (pixels): gain and shading "
-                  "removed, texture kept (0 = raw intensities)")
-      ->check(CLI::Range(0.0, 20.0))
-      ->capture_default_str();
+  if (first_pass)
+    sub->add_option("--motion-highpass", o->step.highpass_sigma,
+                    "First motion pass on the log intensities minus their blur of this sigma (pixels): gain "
+                    "and shading removed, texture kept (0 = the raw intensities)")
+        ->check(CLI::Range(0.0, 20.0))
+        ->capture_default_str();
   sub->add_option("--hull-weight", o->hull_weight,
                   "Blend of the per-frame normal correction towards the frame's hull fit (0 = off)")
       ->capture_default_str();
@@ -198,14 +199,23 @@ solver::ReconstructionOptions ReconstructionArguments::Options() const {
   return result;
 }
 
+void AddRetrackOptions(CLI::App* sub, solver::ReconstructionOptions* o) {
+  sub->add_option("--retrack-weight", o->retrack_weight,
+                  "Blend of the second motion pass towards each frame's refined surface (0..1)")
+      ->capture_default_str();
+  sub->add_option("--retrack-highpass", o->retrack_highpass,
+                  "Second motion pass on the log intensities minus their blur of this sigma (pixels): gain "
+                  "and shading removed, texture kept (0 = the raw intensities)")
+      ->check(CLI::Range(0.0, 20.0))
+      ->capture_default_str();
+}
+
 void AddReconstructionOptions(CLI::App* sub, ReconstructionArguments* arguments) {
   sub->add_flag("--no-refine", arguments->no_refine,
                 "Stop after motion initialization (no spatio-temporal stereo refinement)");
   sub->add_flag("!--no-retrack", arguments->options.retrack,
                 "Keep the first motion pass (do not re-estimate trajectories on the refined shapes)");
-  sub->add_option("--retrack-weight", arguments->options.retrack_weight,
-                  "Blend of the second motion pass towards each frame's refined surface (0..1)")
-      ->capture_default_str();
+  AddRetrackOptions(sub, &arguments->options);
   AddShapeInitOptions(sub, &arguments->options.shape, &arguments->evidence);
   AddMotionInitOptions(sub, &arguments->options.motion);
   AddRefinementOptions(sub, &arguments->options.refinement);

@@ -26,8 +26,12 @@ void AddFramesOption(CLI::App* app, int* first, int* count, bool allow_count);
 // are rejected naming the flag).
 void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::string* evidence);
 
-// --motion-smoothness, --hull-weight.
-void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options);
+// --motion-smoothness, --hull-weight, and with `first_pass` --motion-highpass (the retrack
+// has its own, AddRetrackOptions).
+void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options, bool first_pass = true);
+
+// --retrack-weight, --retrack-highpass.
+void AddRetrackOptions(CLI::App* app, solver::ReconstructionOptions* options);
 
 // --refine-from, --refine-to, --window, --window-overlap, --rounds, --iterations,
 // --linear-solver, --threads, --samples-per-pixel, --max-cameras and the term weights.

@@ -154,7 +154,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StereoRefinementOptions, coarses
 inline void to_json(nlohmann::json& json, const ReconstructionOptions& options) {
   json = {{"shape_init", options.shape},   {"motion_init", options.motion},
           {"refinement", options.refinement}, {"refine", options.refine},
-          {"retrack", options.retrack},    {"retrack_weight", options.retrack_weight}};
+          {"retrack", options.retrack},    {"retrack_weight", options.retrack_weight},
+          {"retrack_highpass", options.retrack_highpass}};
 }
 inline void from_json(const nlohmann::json& json, ReconstructionOptions& options) {
   json.at("shape_init").get_to(options.shape);
@@ -163,6 +164,8 @@ inline void from_json(const nlohmann::json& json, ReconstructionOptions& options
   json.at("refine").get_to(options.refine);
   json.at("retrack").get_to(options.retrack);
   json.at("retrack_weight").get_to(options.retrack_weight);
+  // Options files written before the retrack's high-pass have none: its default.
+  options.retrack_highpass = json.value("retrack_highpass", ReconstructionOptions().retrack_highpass);
 }
 
 }  // namespace subflow::solver

@@ -37,6 +37,14 @@ fi
 scene bust_still   bust    --rig front --cameras 11 --environment room --shadows --frames 1 --start-frame 30
 scene bust_still_bare bust --rig front --cameras 11 --environment room --shadows --frames 1 --start-frame 30 \
   --no-masks --no-background
+# The same pair of stills on two wider rigs: the critter's ring of 10 and the pair's dome of 10
+# (each camera with 1–2 sweep neighbours within 70°; docs/shape.md, "Still sets without masks").
+scene critter_still critter --rig ring --cameras 10 --environment room --shadows --frames 1 --start-frame 12
+scene critter_still_bare critter --rig ring --cameras 10 --environment room --shadows --frames 1 --start-frame 12 \
+  --no-masks --no-background
+scene pair_still   pair    --rig dome --cameras 10 --environment room --frames 1 --start-frame 12
+scene pair_still_bare pair --rig dome --cameras 10 --environment room --frames 1 --start-frame 12 \
+  --no-masks --no-background
 # Takes like a real capture: 4 cameras, portrait, lens distortion, a walker outside the
 # working volume and a ball crossing in front of cam00, MP4 videos, no masks, no background.
 # take_small (272×480, 24 frames) is in the baseline; take_hd (1088×1920, 100 frames) is

@@ -16,11 +16,14 @@ void ReconstructionOptions::Check() const {
   if (refine) refinement.Check();
   if (!(retrack_weight >= 0.0 && retrack_weight <= 1.0))
     ThrowError("reconstruction options", "retrack_weight", "must be in [0, 1]");
+  if (!(retrack_highpass >= 0.0 && retrack_highpass <= 20.0))
+    ThrowError("reconstruction options", "retrack_highpass", "expected a value in [0, 20] pixels (0 = off)");
 }
 
 MotionInitOptions ReconstructionOptions::RetrackOptions() const {
   MotionInitOptions retrack = motion;
   retrack.hull_weight = retrack_weight;
+  retrack.step.highpass_sigma = retrack_highpass;
   // Each step starts at the refined trajectories' own step (blob, 24 frames: end-point error
   // 0.0422 → 0.0402 relative, accuracy P90 0.4357 → 0.4313 mm, same time; bust_front and
   // pair_dome, 8 frames: 0.0576 → 0.0564, 0.1806 → 0.1799). A single pass at σ = 1 from that

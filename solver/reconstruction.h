@@ -43,10 +43,18 @@ struct ReconstructionOptions {
   // frames), mean end-point error / accuracy P90: 0.5 → 0.081 / 0.559 mm, 0.25 → 0.062 /
   // 0.543 mm (frames 10–12: 1.0 → 0.090 mm, 0.5 → 0.064 mm at the same accuracy).
   double retrack_weight = 0.25;
+  // σ (pixels) of the retrack's LogHighPass (MotionStepOptions::highpass_sigma of the second
+  // motion pass; 0 = the intensities). The retrack starts at the refined trajectories, within
+  // the fine structure's narrow linear range, and on it the flow's end-point error falls on
+  // every rendered scene (first 8 frames: bust_front 0.057 → 0.040, critter_ring 0.110 →
+  // 0.089, pair_dome 0.172 → 0.145, blob 0.0348 → 0.0321; docs/shape.md, "Motion on the
+  // images' fine structure").
+  double retrack_highpass = 0.7;
 
   void Check() const;  // throws subflow::Error naming the field
-  // The options of the second motion pass: `motion` with hull_weight = retrack_weight and
-  // each step started at the refined trajectories' step (guess_from_targets).
+  // The options of the second motion pass: `motion` with hull_weight = retrack_weight,
+  // step.highpass_sigma = retrack_highpass and each step started at the refined
+  // trajectories' step (guess_from_targets).
   MotionInitOptions RetrackOptions() const;
 };
 

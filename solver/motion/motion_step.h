@@ -46,9 +46,10 @@ struct MotionStepOptions {
   // first_highpass_sigma): on the fine structure alone a 5 px translation from zero is lost
   // (95.7 % sample error; 12.8 % with the coarse first pass, 3.8 % on the intensities),
   // and a first pass on the intensities gives up the invariance to an exposure change.
-  // Off by default: at 0.7 px the flow's end-point error falls on every rendered scene
-  // (2–31 %), but it was not yet measured on a real take (docs/shape.md, "Motion on the
-  // images' fine structure").
+  // 0 here: motion initialization from the hulls starts from zero motion, and real takes
+  // move limbs by several pixels a frame. The retrack, which starts at the refined
+  // trajectories, uses 0.7 px by default (ReconstructionOptions::retrack_highpass; docs/shape.md,
+  // "Motion on the images' fine structure").
   double highpass_sigma = 0.0;
   double first_highpass_sigma = 8.0;
 

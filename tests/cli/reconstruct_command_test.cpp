@@ -56,10 +56,15 @@ TEST(ReconstructCommand, WritesTheOutputLayoutWithFlowProperties) {
   for (const char* stage : {"shape_init", "motion_init", "refinement", "retrack", "total"})
     EXPECT_GT(report["timings_seconds"][stage].get<double>(), 0.0) << stage;
   EXPECT_EQ(report["rigid_motion"].size(), 2u);
-  // Each motion pass records the options it ran with: the second one its own hull weight.
+  // Each motion pass records the options it ran with: the second one its own hull weight
+  // and high-pass (by default the first pass reads the intensities, the retrack the fine
+  // structure).
   EXPECT_EQ(report["motion_init"]["options"]["hull_weight"], report["options"]["motion_init"]["hull_weight"]);
   EXPECT_EQ(report["retrack"]["options"]["hull_weight"], report["options"]["retrack_weight"]);
   EXPECT_NE(report["retrack"]["options"]["hull_weight"], report["motion_init"]["options"]["hull_weight"]);
+  EXPECT_EQ(report["motion_init"]["options"]["step"]["highpass_sigma"], 0.0);
+  EXPECT_EQ(report["retrack"]["options"]["step"]["highpass_sigma"], report["options"]["retrack_highpass"]);
+  EXPECT_GT(report["options"]["retrack_highpass"].get<double>(), 0.0);
   ASSERT_EQ(report["refinement"]["frames"].size(), 3u);
   for (const auto& frame : report["refinement"]["frames"]) {
     EXPECT_GT(frame["stereo_pairs"].get<int>(), 0);

@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "solver/rigid/rigid_motion.h"
+#include "solver/reconstruction.h"
 #include "solver/rigid/rigid_split.h"
 #include "tests/solver/motion_test_scene.h"
 
@@ -169,10 +170,11 @@ TEST(MotionStep, RecoversAKnownSmallRotation) {
 }
 
 // A camera whose exposure changes between two frames (auto exposure, mains flicker on a fast
-// shutter): every pixel of the second image is 12 % brighter. On the intensities that change
-// reads as motion; on the images' fine structure (LogHighPass with highpass_sigma 0.7, the σ
-// measured best on the scenes; the option is off by default, see motion_step.h), where a gain
-// is an offset that the high-pass removes, the step recovers the motion as without the change.
+// shutter): every pixel of the second image is 12 % brighter. On the intensities
+// (highpass_sigma 0, the first motion pass's default) that change reads as motion; on the
+// images' fine structure (LogHighPass, the retrack's default: 0.7 px after a first pass at
+// 8 px, see motion_step.h), where a gain is an offset that the high-pass removes, the step
+// recovers the motion as without the change.
 TEST(MotionStep, AnExposureChangeIsNotTakenForMotion) {
   const MotionTestScene& scene = Scene();
   RigidTransform motion;
@@ -183,13 +185,14 @@ TEST(MotionStep, AnExposureChangeIsNotTakenForMotion) {
   for (std::size_t k = 0; k < after.size(); ++k) after[k].convertTo(brighter[k], -1, 1.12);
   const Positions truth = motion.Apply(scene.control) - scene.control;
   auto error = [&](double highpass_sigma, const std::vector<cv::Mat>& second) {
-    MotionStepOptions options;
+    MotionStepOptions options = ReconstructionOptions().RetrackOptions().step;  // the retrack's
     options.highpass_sigma = highpass_sigma;
     const MotionStepEstimator estimator(scene.hierarchy, scene.cameras, scene.control, options);
     return SampleMotionError(estimator, scene.control, estimator.Estimate(scene.control, before, second).displacement,
                              truth);
   };
-  const double sigma = 0.7;
+  const double sigma = ReconstructionOptions().RetrackOptions().step.highpass_sigma;
+  ASSERT_GT(sigma, 0.0) << "the retrack's default is the fine structure";
   const double raw_same = error(0.0, after), raw_brighter = error(0.0, brighter);
   const double structure_same = error(sigma, after), structure_brighter = error(sigma, brighter);
   std::printf("translation 1.5 mm, sample motion error: intensities %.1f %% (12 %% brighter: %.1f %%), fine "
