@@ -115,12 +115,12 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
 void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o, bool first_pass) {
   sub->add_option("--motion-smoothness", o->step.solver.smoothness,
                   "Smoothness weight of the normal-flow solver (aperture problem)")->capture_default_str();
-  if (first_pass)
-    sub->add_option("--motion-highpass", o->step.highpass_sigma,
-                    "First motion pass on the log intensities minus their blur of this sigma (pixels): gain "
-                    "and shading removed, texture kept (0 = the raw intensities)")
-        ->check(CLI::Range(0.0, 20.0))
-        ->capture_default_str();
+  if (!first_pass) return;  // the retrack's are --retrack-highpass and --retrack-weight
+  sub->add_option("--motion-highpass", o->step.highpass_sigma,
+                  "First motion pass on the log intensities minus their blur of this sigma (pixels): gain "
+                  "and shading removed, texture kept (0 = the raw intensities)")
+      ->check(CLI::Range(0.0, 20.0))
+      ->capture_default_str();
   sub->add_option("--hull-weight", o->hull_weight,
                   "Blend of the per-frame normal correction towards the frame's hull fit (0 = off)")
       ->capture_default_str();

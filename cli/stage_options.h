@@ -26,8 +26,8 @@ void AddFramesOption(CLI::App* app, int* first, int* count, bool allow_count);
 // are rejected naming the flag).
 void AddShapeInitOptions(CLI::App* app, solver::ShapeInitOptions* options, std::string* evidence);
 
-// --motion-smoothness, --hull-weight, and with `first_pass` --motion-highpass (the retrack
-// has its own, AddRetrackOptions).
+// --motion-smoothness, and with `first_pass` --motion-highpass and --hull-weight (the
+// retrack has its own: AddRetrackOptions).
 void AddMotionInitOptions(CLI::App* app, solver::MotionInitOptions* options, bool first_pass = true);
 
 // --retrack-weight, --retrack-highpass.
@@ -47,7 +47,7 @@ struct ReconstructionArguments {
   solver::ReconstructionOptions Options() const;
 };
 
-// --no-refine, --no-retrack, --retrack-weight and the options of every stage.
+// --no-refine, --no-retrack, --retrack-weight, --retrack-highpass and the options of every stage.
 void AddReconstructionOptions(CLI::App* app, ReconstructionArguments* arguments);
 
 }  // namespace subflow::cli

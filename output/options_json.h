@@ -164,8 +164,9 @@ inline void from_json(const nlohmann::json& json, ReconstructionOptions& options
   json.at("refine").get_to(options.refine);
   json.at("retrack").get_to(options.retrack);
   json.at("retrack_weight").get_to(options.retrack_weight);
-  // Options files written before the retrack's high-pass have none: its default.
-  options.retrack_highpass = json.value("retrack_highpass", ReconstructionOptions().retrack_highpass);
+  // Options files written before the retrack had its own high-pass have none: their retrack
+  // ran on the first pass's (motion_init.step.highpass_sigma), and still does.
+  options.retrack_highpass = json.value("retrack_highpass", options.motion.step.highpass_sigma);
 }
 
 }  // namespace subflow::solver

@@ -44,11 +44,13 @@ struct ReconstructionOptions {
   // 0.543 mm (frames 10–12: 1.0 → 0.090 mm, 0.5 → 0.064 mm at the same accuracy).
   double retrack_weight = 0.25;
   // σ (pixels) of the retrack's LogHighPass (MotionStepOptions::highpass_sigma of the second
-  // motion pass; 0 = the intensities). The retrack starts at the refined trajectories, within
-  // the fine structure's narrow linear range, and on it the flow's end-point error falls on
-  // every rendered scene (first 8 frames: bust_front 0.057 → 0.040, critter_ring 0.110 →
-  // 0.089, pair_dome 0.172 → 0.145, blob 0.0348 → 0.0321; docs/shape.md, "Motion on the
-  // images' fine structure").
+  // motion pass, whose first image pass is at motion.step.first_highpass_sigma; 0 = the
+  // intensities). The retrack mostly starts at the refined trajectories, within the fine
+  // structure's narrow linear range (where they match the images worse than no motion, as on
+  // real takes, from zero). The flow's end-point error falls on every rendered scene (first 8
+  // frames, the blob 24: bust_front 0.057 → 0.040, critter_ring 0.110 → 0.089, pair_dome 0.172
+  // → 0.145, blob 0.0348 → 0.0321), also on the real-like take_small whose retrack starts
+  // every step from zero (1.58 → 1.14; docs/shape.md, "Motion on the images' fine structure").
   double retrack_highpass = 0.7;
 
   void Check() const;  // throws subflow::Error naming the field

@@ -47,9 +47,9 @@ struct MotionStepOptions {
   // (95.7 % sample error; 12.8 % with the coarse first pass, 3.8 % on the intensities),
   // and a first pass on the intensities gives up the invariance to an exposure change.
   // 0 here: motion initialization from the hulls starts from zero motion, and real takes
-  // move limbs by several pixels a frame. The retrack, which starts at the refined
-  // trajectories, uses 0.7 px by default (ReconstructionOptions::retrack_highpass; docs/shape.md,
-  // "Motion on the images' fine structure").
+  // move limbs by several pixels a frame. The retrack, which mostly starts at the refined
+  // trajectories, uses 0.7 px by default (ReconstructionOptions::retrack_highpass;
+  // docs/shape.md, "Motion on the images' fine structure").
   double highpass_sigma = 0.0;
   double first_highpass_sigma = 8.0;
 

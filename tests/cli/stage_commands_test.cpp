@@ -111,6 +111,35 @@ TEST(StageCommands, TheChainOfStageCommandsGivesWhatReconstructGives) {
   for (const char* section : {"shape_init", "motion_init", "refinement", "retrack", "rigid_motion", "flow"})
     EXPECT_TRUE(report.contains(section)) << section;
   EXPECT_EQ(report["retrack"]["options"]["hull_weight"], 0.25);
+  EXPECT_EQ(report["retrack"]["options"]["step"]["highpass_sigma"], 0.7);
+}
+
+// Each motion pass offers its own flags: the retrack's hull weight and high-pass are
+// --retrack-weight and --retrack-highpass (RetrackOptions sets them over the first pass's),
+// so the retrack command refuses the first pass's rather than ignore them, and a value given
+// reaches the retrack's report.
+TEST(StageCommands, TheRetrackTakesItsOwnWeightAndHighPass) {
+  const test::CommandResult motion = RunSubflow("motion --help", Scratch().path());
+  const test::CommandResult retrack = RunSubflow("retrack --help", Scratch().path());
+  for (const char* flag : {"--motion-highpass", "--hull-weight"}) {
+    EXPECT_NE(motion.out.find(flag), std::string::npos) << flag;
+    EXPECT_EQ(retrack.out.find(flag), std::string::npos) << flag;
+  }
+  for (const char* flag : {"--retrack-highpass", "--retrack-weight"}) {
+    EXPECT_EQ(motion.out.find(flag), std::string::npos) << flag;
+    EXPECT_NE(retrack.out.find(flag), std::string::npos) << flag;
+  }
+  const fs::path work = Scratch().Subdirectory("retrack_flags");
+  const std::string from = " --from " + Quoted(Reconstructed() / "stages" / "refine");
+  const test::CommandResult refused =
+      RunSubflow("retrack " + Quoted(Dataset()) + from + " --out " + Quoted(work / "a") + " --motion-highpass 1",
+                 Scratch().path());
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_FALSE(fs::exists(work / "a" / "report.json"));
+  RunOk("retrack " + Quoted(Dataset()) + from + " --out " + Quoted(work / "b") + " --retrack-highpass 1.5");
+  const nlohmann::json report = ReadReport(work / "b");
+  EXPECT_EQ(report["options"]["retrack"]["step"]["highpass_sigma"], 1.5);
+  EXPECT_EQ(report["retrack"]["options"]["step"]["highpass_sigma"], 1.5);
 }
 
 TEST(StageCommands, ResumeLoadsTheCompleteStagesAndEndsWithTheSameResult) {

@@ -94,5 +94,19 @@ TEST(OptionsJson, EnumsAreRecordedByTheirCommandLineNames) {
   EXPECT_THROW(bad.get<solver::ReconstructionOptions>(), Error);
 }
 
+// An options file written before the retrack had its own high-pass (no "retrack_highpass")
+// runs its retrack as it ran then: on the first motion pass's high-pass.
+TEST(OptionsJson, AnOlderFileKeepsItsRetrackOnTheFirstPasssHighPass) {
+  solver::ReconstructionOptions options;
+  options.motion.step.highpass_sigma = 1.5;
+  nlohmann::json json = options;
+  ASSERT_NE(options.retrack_highpass, 1.5);
+  EXPECT_EQ(json.get<solver::ReconstructionOptions>().retrack_highpass, options.retrack_highpass);
+  json.erase("retrack_highpass");
+  const solver::ReconstructionOptions older = json.get<solver::ReconstructionOptions>();
+  EXPECT_EQ(older.retrack_highpass, 1.5);
+  EXPECT_EQ(older.RetrackOptions().step.highpass_sigma, 1.5);
+}
+
 }  // namespace
 }  // namespace subflow::output

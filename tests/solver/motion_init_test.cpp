@@ -10,8 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
-#include "solver/rigid/rigid_motion.h"
 #include "solver/reconstruction.h"
+#include "solver/rigid/rigid_motion.h"
 #include "solver/rigid/rigid_split.h"
 #include "tests/solver/motion_test_scene.h"
 
