@@ -119,7 +119,7 @@ void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o, bool firs
   sub->add_option("--motion-highpass", o->step.highpass_sigma,
                   "First motion pass on the log intensities minus their blur of this sigma (pixels): gain "
                   "and shading removed, texture kept (0 = the raw intensities)")
-      ->check(CLI::Range(0.0, 20.0))
+      ->check(CLI::Range(0.0, solver::kMaxHighPassSigma))
       ->capture_default_str();
   sub->add_option("--hull-weight", o->hull_weight,
                   "Blend of the per-frame normal correction towards the frame's hull fit (0 = off)")
@@ -206,7 +206,7 @@ void AddRetrackOptions(CLI::App* sub, solver::ReconstructionOptions* o) {
   sub->add_option("--retrack-highpass", o->retrack_highpass,
                   "Second motion pass on the log intensities minus their blur of this sigma (pixels): gain "
                   "and shading removed, texture kept (0 = the raw intensities)")
-      ->check(CLI::Range(0.0, 20.0))
+      ->check(CLI::Range(0.0, solver::kMaxHighPassSigma))
       ->capture_default_str();
 }
 

@@ -16,8 +16,9 @@ void ReconstructionOptions::Check() const {
   if (refine) refinement.Check();
   if (!(retrack_weight >= 0.0 && retrack_weight <= 1.0))
     ThrowError("reconstruction options", "retrack_weight", "must be in [0, 1]");
-  if (!(retrack_highpass >= 0.0 && retrack_highpass <= 20.0))
-    ThrowError("reconstruction options", "retrack_highpass", "expected a value in [0, 20] pixels (0 = off)");
+  if (!(retrack_highpass >= 0.0 && retrack_highpass <= kMaxHighPassSigma))
+    ThrowError("reconstruction options", "retrack_highpass",
+               fmt::format("expected a value in [0, {}] pixels (0 = off)", kMaxHighPassSigma));
 }
 
 MotionInitOptions ReconstructionOptions::RetrackOptions() const {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include <spdlog/fmt/fmt.h>
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
@@ -45,8 +46,9 @@ void MotionStepOptions::Check() const {
   for (double sigma : image_sigmas)
     if (!std::isfinite(sigma) || sigma < 0.0 || sigma > 20.0)
       ThrowError("motion step", "image_sigmas", "expected values in [0, 20] pixels");
-  if (!std::isfinite(highpass_sigma) || highpass_sigma < 0.0 || highpass_sigma > 20.0)
-    ThrowError("motion step", "highpass_sigma", "expected a value in [0, 20] pixels (0 = off)");
+  if (!std::isfinite(highpass_sigma) || highpass_sigma < 0.0 || highpass_sigma > kMaxHighPassSigma)
+    ThrowError("motion step", "highpass_sigma",
+               fmt::format("expected a value in [0, {}] pixels (0 = off)", kMaxHighPassSigma));
   if (!std::isfinite(first_highpass_sigma) || first_highpass_sigma < 0.0 || first_highpass_sigma > 100.0)
     ThrowError("motion step", "first_highpass_sigma", "expected a value in [0, 100] pixels");
 }
@@ -100,15 +102,24 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
     sample_motion = solver_.SampleMotion(*guess);
   }
   const int passes = static_cast<int>(options_.image_sigmas.size());
+  // The first of several passes on a coarser high-pass: its wider linear range brings a
+  // motion of a few pixels within the fine structure's.
+  const auto pass_highpass = [&](int pass) {
+    return pass == 0 && passes > 1 && options_.highpass_sigma > 0.0
+               ? std::max(options_.highpass_sigma, options_.first_highpass_sigma)
+               : options_.highpass_sigma;
+  };
   std::vector<SmoothedImage> smoothed_before, smoothed_after;
+  std::vector<cv::Mat> structure_before, structure_after;  // the high-pass of this pass, and of the next
   for (int pass = 0; pass < passes; ++pass) {
-    // The first of several passes on a coarser high-pass: its wider linear range brings a
-    // motion of a few pixels within the fine structure's.
-    const double highpass = pass == 0 && passes > 1 && options_.highpass_sigma > 0.0
-                                ? std::max(options_.highpass_sigma, options_.first_highpass_sigma)
-                                : options_.highpass_sigma;
-    smoothed_before = SmoothAll(Structure(before, highpass), options_.image_sigmas[pass]);
-    smoothed_after = SmoothAll(Structure(after, highpass), options_.image_sigmas[pass]);
+    const double highpass = pass_highpass(pass);
+    if (pass == 0 || highpass != pass_highpass(pass - 1)) {
+      structure_before = Structure(before, highpass);
+      structure_after = Structure(after, highpass);
+    }
+    smoothed_before = SmoothAll(structure_before, options_.image_sigmas[pass]);
+    smoothed_after = SmoothAll(structure_after, options_.image_sigmas[pass]);
+    if (pass + 1 == passes || pass_highpass(pass + 1) != highpass) structure_before = structure_after = {};
     if (pass == 0 && guess) {
       // The guess is a start, not a given: where it matches the images worse than no motion
       // does (trajectories that jump from frame to frame), the step starts from zero.

@@ -35,6 +35,11 @@
 
 namespace subflow::solver {
 
+// The largest high-pass σ (pixels) a motion pass accepts: the motion stage's
+// highpass_sigma and the retrack's ReconstructionOptions::retrack_highpass, in options files
+// and on the command line. Beyond it the high-pass keeps little but the shading it removes.
+inline constexpr double kMaxHighPassSigma = 20.0;
+
 struct MotionStepOptions {
   SurfaceSamplingOptions sampling;
   VisibilityOptions visibility;
