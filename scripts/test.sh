@@ -3,7 +3,7 @@
 # AddressSanitizer + UndefinedBehaviorSanitizer (clang, build-asan/, scripts/sanitize.sh) and
 # runs them all (CTest + GoogleTest; the command tests run an instrumented `subflow`), then
 # each reader's fuzz harness for a short fixed time (scripts/fuzz.sh, SUBFLOW_FUZZ_SECONDS,
-# default 10). Measured on a fresh clone with 2 cores: ~36 min in all.
+# default 10). Measured on a fresh clone with 2 cores: ~40 min in all (README).
 # SUBFLOW_TEST_RELEASE_ONLY=1 instead builds build/ (Release, gcc: what the README's main
 # command runs) and runs every test there: a quicker local run, no sanitizers, no fuzzing.
 set -euo pipefail
