@@ -110,10 +110,11 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
                : options_.highpass_sigma;
   };
   std::vector<SmoothedImage> smoothed_before, smoothed_after;
-  std::vector<cv::Mat> structure_before, structure_after;  // the high-pass of this pass, and of the next
+  // The high-pass of this pass; kept for the next pass when it uses the same, else freed.
+  std::vector<cv::Mat> structure_before, structure_after;
   for (int pass = 0; pass < passes; ++pass) {
     const double highpass = pass_highpass(pass);
-    if (pass == 0 || highpass != pass_highpass(pass - 1)) {
+    if (structure_before.empty()) {
       structure_before = Structure(before, highpass);
       structure_after = Structure(after, highpass);
     }
