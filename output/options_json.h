@@ -87,7 +87,8 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DepthFusionOptions, consistent_cameras, consi
                                    min_component_fraction)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SupportPlaneOptions, tolerance, iterations, sample_points, min_inlier_fraction,
                                    min_above_fraction, seed)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StillEvidenceOptions, enabled, sweep, fusion, remove_support_plane,
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(PlainBackdropOptions, enabled, border_fraction, spread_quantile, max_spread)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StillEvidenceOptions, enabled, backdrop, sweep, fusion, remove_support_plane,
                                    support_plane, support_tolerance_planes)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ConcavityCarvingOptions, enabled, every_frame, sweep, fusion, min_neighbours,
                                    pixels_per_voxel, surface_margin_voxels, surface_veto, opening_radius, min_depth,

@@ -20,7 +20,7 @@ LIST=("$@")
 mask_scene() {  # the dataset with the same images and masks
   case $1 in
     critter_nomasks) echo critter_ring ;;
-    bust_still_bare|critter_still_bare|pair_still_bare) echo "${1%_bare}" ;;
+    *_still_bare) echo "${1%_bare}" ;;
     take_small|take_hd) echo "" ;;
     *) echo "$1" ;;
   esac

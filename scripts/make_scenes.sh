@@ -45,6 +45,14 @@ scene critter_still_bare critter --rig ring --cameras 10 --environment room --sh
 scene pair_still   pair    --rig dome --cameras 10 --environment room --frames 1 --start-frame 12
 scene pair_still_bare pair --rig dome --cameras 10 --environment room --frames 1 --start-frame 12 \
   --no-masks --no-background
+# The three stills on the default plain dark backdrop (no room), with and without masks: the
+# plain-backdrop evidence (docs/shape.md, "Still sets on a plain backdrop").
+scene bust_dark_still bust --rig front --cameras 11 --frames 1 --start-frame 30
+scene bust_dark_still_bare bust --rig front --cameras 11 --frames 1 --start-frame 30 --no-masks --no-background
+scene critter_dark_still critter --rig ring --cameras 10 --frames 1 --start-frame 12
+scene critter_dark_still_bare critter --rig ring --cameras 10 --frames 1 --start-frame 12 --no-masks --no-background
+scene pair_dark_still pair --rig dome --cameras 10 --frames 1 --start-frame 12
+scene pair_dark_still_bare pair --rig dome --cameras 10 --frames 1 --start-frame 12 --no-masks --no-background
 # Takes like a real capture: 4 cameras, portrait, lens distortion, a walker outside the
 # working volume and a ball crossing in front of cam00, MP4 videos, no masks, no background.
 # take_small (272×480, 24 frames) is in the baseline; take_hd (1088×1920, 100 frames) is

@@ -119,6 +119,7 @@ SupportPlane FindPlane(const std::vector<Camera>& cameras, const std::vector<cv:
 }  // namespace
 
 void StillEvidenceOptions::Check() const {
+  backdrop.Check();
   sweep.Check();
   fusion.Check();
   support_plane.Check();

@@ -33,6 +33,7 @@
 
 #include "vision/camera.h"
 #include "vision/depth_fusion.h"
+#include "vision/plain_backdrop.h"
 #include "vision/plane_sweep.h"
 #include "vision/support_plane.h"
 #include "vision/working_volume.h"
@@ -43,6 +44,10 @@ struct StillEvidenceOptions {
   // Shape initialization uses the still evidence when nothing else finds the object
   // (solver/shape/shape_init.h); false = never (such datasets are then an error).
   bool enabled = true;
+  // Before the photo-consistency: when every camera's backdrop is plain
+  // (vision/plain_backdrop.h), the silhouettes are the differences to its colour instead
+  // (solver/shape/shape_init.h); enabled = false: always the photo-consistency.
+  PlainBackdropOptions backdrop;
   PlaneSweepOptions sweep;
   DepthFusionOptions fusion;
   // Find and remove a support plane (step 3).

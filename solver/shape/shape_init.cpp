@@ -8,6 +8,7 @@
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
@@ -16,6 +17,8 @@
 #include "geometry/closest_point.h"
 #include "geometry/mean_edge_length.h"
 #include "core/error.h"
+#include "vision/plain_backdrop.h"
+#include "vision/silhouettes.h"
 #include "vision/working_scale.h"
 
 namespace subflow::solver {
@@ -213,15 +216,68 @@ std::vector<vision::Silhouette> StandingSilhouettes(const std::vector<vision::Es
   return standing;
 }
 
-// The still evidence of the reference frame (vision/still_evidence.h) as silhouettes of
-// source kStill, on the evidence's working cameras.
+// The silhouettes of a still set against a plain backdrop (vision/plain_backdrop.h): every
+// camera's image of `reference` compared with its backdrop's colour as with a background
+// image, with two differences (docs/shape.md, "Still sets on a plain backdrop"):
+//  - the threshold is the difference histogram's (no surely-background pixels given), not
+//    the backdrop's noise: against a backdrop that noiseless, the noise threshold also takes
+//    in the dim props beside the object (the Middlebury dino's dark stand), which differ
+//    from it by a few levels where the object differs by far more;
+//  - no shadow test: on a backdrop without texture, a part of the object darker than the
+//    backdrop fits a shadow's gain as well as a shadow does, and was carved away (a
+//    sphere's shaded side); a shadow cast on the backdrop now stays in the silhouette,
+//    which only makes the hull larger.
+// Empty when some camera's backdrop is not plain (result->backdrops has every camera's
+// figures either way).
+std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& dataset, int reference,
+                                                    const std::vector<vision::Camera>& cameras,
+                                                    const ShapeInitOptions& options, ShapeInitResult* result) {
+  const vision::PlainBackdropOptions& backdrop = options.still.backdrop;
+  if (!backdrop.enabled) return {};
+  std::vector<cv::Mat> images(cameras.size());
+  result->backdrops.assign(cameras.size(), vision::PlainBackdrop());
+  tbb::parallel_for(0, static_cast<int>(cameras.size()), [&](int k) {
+    images[k] = vision::ResizeToCamera(dataset.Image(k, reference), cameras[k]);
+    result->backdrops[k] = vision::MeasureBackdrop(images[k], vision::BorderBand(images[k].size(), backdrop), backdrop);
+  });
+  const auto plain = [](const vision::PlainBackdrop& b) { return b.plain; };
+  if (!std::all_of(result->backdrops.begin(), result->backdrops.end(), plain)) {
+    const auto widest = std::max_element(result->backdrops.begin(), result->backdrops.end(),
+                                         [](const auto& a, const auto& b) { return a.spread < b.spread; });
+    spdlog::info("no plain backdrop ({} of {} cameras; widest spread {:.3f} > {:.3f} in camera {})",
+                 std::count_if(result->backdrops.begin(), result->backdrops.end(), plain), cameras.size(),
+                 widest->spread, backdrop.max_spread, dataset.camera(widest - result->backdrops.begin()).name());
+    return {};
+  }
+  vision::SilhouetteOptions plain_options = options.silhouettes;
+  plain_options.background_shadow_test = false;
+  std::vector<vision::Silhouette> silhouettes(cameras.size());
+  tbb::parallel_for(0, static_cast<int>(cameras.size()), [&](int k) {
+    silhouettes[k] = vision::SilhouetteFromBackground(
+        images[k], vision::BackdropImage(images[k], result->backdrops[k]), plain_options);
+    silhouettes[k].source = vision::EvidenceSource::kStill;
+  });
+  result->used_backdrop = true;
+  double spread = 0;
+  for (const vision::PlainBackdrop& b : result->backdrops) spread = std::max(spread, b.spread);
+  spdlog::info("no masks, no background and nothing moves: frame {} against a plain backdrop in every camera "
+               "(widest spread {:.3f})",
+               reference, spread);
+  return silhouettes;
+}
+
+// The still evidence of the reference frame as silhouettes of source kStill, on the
+// evidence's working cameras: against a plain backdrop when every camera has one, else
+// the photo-consistency (vision/still_evidence.h).
 std::vector<vision::Silhouette> StillSilhouettes(const vision::Dataset& dataset, int reference,
                                                  const std::vector<vision::Camera>& cameras, int resolution,
                                                  const ShapeInitOptions& options, ShapeInitResult* result) {
+  result->used_still = true;
+  std::vector<vision::Silhouette> silhouettes = BackdropSilhouettes(dataset, reference, cameras, options, result);
+  if (!silhouettes.empty()) return silhouettes;
   result->still = vision::ComputeStillEvidence(cameras, WorkingGrayImages(dataset, reference, cameras),
                                                dataset.bounds(), resolution, options.still);
-  result->used_still = true;
-  std::vector<vision::Silhouette> silhouettes(cameras.size());
+  silhouettes.resize(cameras.size());
   for (std::size_t k = 0; k < cameras.size(); ++k) {
     silhouettes[k] = vision::SilhouetteFromMask(result->still.silhouettes[k], options.silhouettes);
     silhouettes[k].source = vision::EvidenceSource::kStill;
@@ -403,8 +459,10 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
     standing.evidence.release(), standing.mask.release(), standing.measure.release();
   if (result.used_still && std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end())
     ThrowError(dataset.directory(), "evidence",
-               "no masks, no background, nothing moves, and the photo-consistency of the still set (evidence "
-               "\"still\") found no surface either: cannot find the object (give masks or background images)");
+               std::string("no masks, no background, nothing moves, and ") +
+                   (result.used_backdrop ? "nothing differs from the plain backdrop"
+                                         : "the photo-consistency of the still set found no surface either") +
+                   " (evidence \"still\"): cannot find the object (give masks or background images)");
   TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames,
                                    store);
 

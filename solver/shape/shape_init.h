@@ -148,8 +148,12 @@ struct ShapeInitResult {
   // Per camera, the standing silhouette added to every frame's (vision/standing_evidence.h;
   // masks released, figures kept); empty when none was computed.
   std::vector<vision::Silhouette> standing;
-  // The still set's evidence, when it was used (used_still; silhouettes released).
+  // The still set's evidence, when it was used (used_still): against a plain backdrop
+  // (used_backdrop; `backdrops`: every camera's figures, also when some were not plain),
+  // else the photo-consistency (`still`, silhouettes released).
   bool used_still = false;
+  bool used_backdrop = false;
+  std::vector<vision::PlainBackdrop> backdrops;
   vision::StillEvidence still;
   // Per camera, the scale of the images the evidence was computed on (1 = stored size;
   // VoxelCarvingOptions::max_pixels_per_voxel).
