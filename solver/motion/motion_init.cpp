@@ -129,6 +129,14 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   const int frame_count = images.frame_count;
   const int n = hierarchy.finest_level();
   const Positions& reference = per_frame ? initial_control[reference_frame] : initial_control[0];
+  if (frame_count == 1) {  // a still: no step to estimate, nor anything to build for one
+    MotionInitResult still;
+    still.reference_frame = reference_frame;
+    still.control = {reference};
+    still.frames.resize(1);
+    still.seconds = start.Seconds();
+    return still;
+  }
   auto fitted = [&](int frame) -> const Positions* {
     if (!per_frame || initial_control[frame].rows() == 0) return nullptr;
     return &initial_control[frame];
