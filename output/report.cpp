@@ -78,6 +78,37 @@ nlohmann::json RegistrationJson(const solver::SurfaceRegistrationReport& r) {
           {"seconds", r.seconds}};
 }
 
+// The still set's evidence, when it was used (null: not used): "method" "backdrop" or
+// "photo-consistency", every camera's backdrop figures, and the photo-consistency's.
+nlohmann::json StillJson(const vision::Dataset& dataset, const solver::ShapeInitResult& result) {
+  if (!result.used_still) return nullptr;
+  nlohmann::json backdrops = nlohmann::json::array();
+  for (size_t c = 0; c < result.backdrops.size(); ++c) {
+    const vision::PlainBackdrop& backdrop = result.backdrops[c];
+    nlohmann::json colour = nlohmann::json::array();
+    for (int channel = 0; channel < backdrop.channels; ++channel) colour.push_back(backdrop.colour[channel]);
+    backdrops.push_back({{"name", dataset.camera(static_cast<int>(c)).name()},
+                         {"plain", backdrop.plain},
+                         {"colour", colour},
+                         {"spread", backdrop.spread},
+                         {"sure_pixels", backdrop.sure_pixels}});
+  }
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const vision::StillCameraReport& camera : result.still.cameras)
+    cameras.push_back({{"name", camera.name}, {"planes", camera.planes}, {"depth_pixels", camera.depth_pixels},
+                       {"trusted_pixels", camera.trusted_pixels}, {"support_pixels", camera.support_pixels},
+                       {"silhouette_pixels", camera.silhouette_pixels}, {"sweep_seconds", camera.sweep_seconds}});
+  const vision::SupportPlane& plane = result.still.support;
+  return {{"method", result.used_backdrop ? "backdrop" : "photo-consistency"},
+          {"backdrops", backdrops},
+          {"support_plane", {{"found", plane.found}, {"normal", Vector3(plane.normal)}, {"offset", plane.offset},
+                             {"tolerance", plane.tolerance}, {"inliers", plane.inliers}, {"points", plane.points},
+                             {"above_fraction", plane.above_fraction}}},
+          {"occupied_voxels", result.still.fused.occupied_voxels},
+          {"cameras", cameras},
+          {"seconds", result.still.seconds}};
+}
+
 }  // namespace
 
 nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::ShapeInitOptions& options,
@@ -116,34 +147,7 @@ nlohmann::json ShapeInitJson(const vision::Dataset& dataset, const solver::Shape
                         {"threshold", result.standing[c].threshold},
                         {"object_pixels", result.standing[c].object_pixels}});
   }
-  // The still set's evidence, when it was used (null: not used): "method" "backdrop" or
-  // "photo-consistency", every camera's backdrop figures, and the photo-consistency's.
-  nlohmann::json still = nullptr;
-  if (result.used_still) {
-    nlohmann::json backdrops = nlohmann::json::array();
-    for (size_t c = 0; c < result.backdrops.size(); ++c) {
-      const vision::PlainBackdrop& backdrop = result.backdrops[c];
-      backdrops.push_back({{"name", dataset.camera(static_cast<int>(c)).name()},
-                           {"plain", backdrop.plain},
-                           {"colour", {backdrop.colour[0], backdrop.colour[1], backdrop.colour[2]}},
-                           {"spread", backdrop.spread},
-                           {"sure_pixels", backdrop.sure_pixels}});
-    }
-    nlohmann::json cameras = nlohmann::json::array();
-    for (const vision::StillCameraReport& camera : result.still.cameras)
-      cameras.push_back({{"name", camera.name}, {"planes", camera.planes}, {"depth_pixels", camera.depth_pixels},
-                         {"trusted_pixels", camera.trusted_pixels}, {"support_pixels", camera.support_pixels},
-                         {"silhouette_pixels", camera.silhouette_pixels}, {"sweep_seconds", camera.sweep_seconds}});
-    const vision::SupportPlane& plane = result.still.support;
-    still = {{"method", result.used_backdrop ? "backdrop" : "photo-consistency"},
-             {"backdrops", backdrops},
-             {"support_plane", {{"found", plane.found}, {"normal", Vector3(plane.normal)}, {"offset", plane.offset},
-                                {"tolerance", plane.tolerance}, {"inliers", plane.inliers}, {"points", plane.points},
-                                {"above_fraction", plane.above_fraction}}},
-             {"occupied_voxels", result.still.fused.occupied_voxels},
-             {"cameras", cameras},
-             {"seconds", result.still.seconds}};
-  }
+  const nlohmann::json still = StillJson(dataset, result);
 
   nlohmann::json frames = nlohmann::json::array();
   double carve = 0, isosurface = 0, fit = 0;

@@ -43,6 +43,7 @@ PlainBackdrop MeasureBackdrop(const cv::Mat& image, const cv::Mat& sure, const P
         for (int c = 0; c < channels; ++c) values[c].push_back(row[x * channels + c]);
   }
   PlainBackdrop backdrop;
+  backdrop.channels = channels;
   backdrop.sure_pixels = static_cast<int>(values[0].size());
   if (backdrop.sure_pixels == 0) return backdrop;
   const auto quantile = [](std::vector<float>* v, double q) {

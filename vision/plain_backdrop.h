@@ -37,7 +37,8 @@ struct PlainBackdropOptions {
 
 struct PlainBackdrop {
   bool plain = false;
-  cv::Scalar colour;    // per channel, in [0, 1] (the image's channel order)
+  cv::Scalar colour;    // per channel, in [0, 1] (the image's channel order: B, G, R or gray)
+  int channels = 0;     // of `colour` (alpha dropped)
   double spread = 0;    // the spread_quantile of the distances to `colour`
   int sure_pixels = 0;  // pixels the figures were read from
 };

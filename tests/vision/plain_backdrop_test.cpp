@@ -40,6 +40,7 @@ cv::Mat Band(int band) {
 TEST(PlainBackdrop, DarkBackdropIsPlainWithItsColourDespiteAnObjectInTheBand) {
   const PlainBackdrop backdrop = MeasureBackdrop(DarkBackdropWithObjects(), Band(3));
   EXPECT_TRUE(backdrop.plain);
+  EXPECT_EQ(backdrop.channels, 3);
   EXPECT_NEAR(backdrop.colour[0], 12 / 255.0, 1.5 / 255);
   EXPECT_NEAR(backdrop.colour[1], 10 / 255.0, 1.5 / 255);
   EXPECT_NEAR(backdrop.colour[2], 8 / 255.0, 1.5 / 255);
