@@ -108,5 +108,24 @@ TEST(OptionsJson, AnOlderFileKeepsItsRetrackOnTheFirstPasssHighPass) {
   EXPECT_EQ(older.RetrackOptions().step.highpass_sigma, 1.5);
 }
 
+// An options file written before the plain backdrop (no "backdrop" in shape_init.still)
+// reads with the backdrop's defaults; the backdrop's own fields round-trip.
+TEST(OptionsJson, AnOlderFileWithoutTheBackdropTakesItsDefaults) {
+  solver::ReconstructionOptions options;
+  options.shape.still.backdrop.max_spread = 0.05;
+  options.shape.still.backdrop.enabled = false;
+  nlohmann::json json = options;
+  const solver::ReconstructionOptions read = json.get<solver::ReconstructionOptions>();
+  EXPECT_EQ(read.shape.still.backdrop.max_spread, 0.05);
+  EXPECT_FALSE(read.shape.still.backdrop.enabled);
+  json["shape_init"]["still"].erase("backdrop");
+  const solver::ReconstructionOptions older = json.get<solver::ReconstructionOptions>();
+  EXPECT_EQ(older.shape.still.backdrop.max_spread, vision::PlainBackdropOptions().max_spread);
+  EXPECT_TRUE(older.shape.still.backdrop.enabled);
+  // Any other missing field of the still options is still an error.
+  json["shape_init"]["still"].erase("sweep");
+  EXPECT_THROW(json.get<solver::ReconstructionOptions>(), std::exception);
+}
+
 }  // namespace
 }  // namespace subflow::output
