@@ -44,7 +44,8 @@ void AddFramesOption(CLI::App* sub, int* first, int* count, bool allow_count) {
 void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string* evidence) {
   sub->add_option("--evidence", *evidence,
                   "Object evidence: auto (masks, else background, else motion (with what stands still), else "
-                  "still: photo-consistency of the reference frame), mask, background, motion, still")
+                  "still: the reference frame against a plain backdrop, else its photo-consistency), mask, "
+                  "background, motion, still")
       ->capture_default_str();
   sub->add_option("--levels", o->levels,
                   "Subdivision levels above the base mesh (-1 = automatic: finest edges about "

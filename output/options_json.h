@@ -88,26 +88,9 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(DepthFusionOptions, consistent_cameras, consi
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SupportPlaneOptions, tolerance, iterations, sample_points, min_inlier_fraction,
                                    min_above_fraction, seed)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(PlainBackdropOptions, enabled, border_fraction, spread_quantile, max_spread)
-inline void to_json(nlohmann::json& json, const StillEvidenceOptions& options) {
-  json = {{"enabled", options.enabled},
-          {"backdrop", options.backdrop},
-          {"sweep", options.sweep},
-          {"fusion", options.fusion},
-          {"remove_support_plane", options.remove_support_plane},
-          {"support_plane", options.support_plane},
-          {"support_tolerance_planes", options.support_tolerance_planes}};
-}
-inline void from_json(const nlohmann::json& json, StillEvidenceOptions& options) {
-  json.at("enabled").get_to(options.enabled);
-  // Options files written before the plain backdrop (2026-12-06) have none: it takes its
-  // defaults, as a run of today's binary would.
-  options.backdrop = json.value("backdrop", PlainBackdropOptions());
-  json.at("sweep").get_to(options.sweep);
-  json.at("fusion").get_to(options.fusion);
-  json.at("remove_support_plane").get_to(options.remove_support_plane);
-  json.at("support_plane").get_to(options.support_plane);
-  json.at("support_tolerance_planes").get_to(options.support_tolerance_planes);
-}
+// WITH_DEFAULT: options files written before `backdrop` existed (2026-12-06) still load.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StillEvidenceOptions, enabled, backdrop, sweep, fusion,
+                                                remove_support_plane, support_plane, support_tolerance_planes)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(ConcavityCarvingOptions, enabled, every_frame, sweep, fusion, min_neighbours,
                                    pixels_per_voxel, surface_margin_voxels, surface_veto, opening_radius, min_depth,
                                    max_carved_fraction,

@@ -79,7 +79,8 @@ nlohmann::json RegistrationJson(const solver::SurfaceRegistrationReport& r) {
 }
 
 // The still set's evidence, when it was used (null: not used): "method" "backdrop" or
-// "photo-consistency", every camera's backdrop figures, and the photo-consistency's.
+// "photo-consistency", every camera's backdrop figures (also when not plain), and the
+// photo-consistency's figures when it ran; "seconds" of the method used.
 nlohmann::json StillJson(const vision::Dataset& dataset, const solver::ShapeInitResult& result) {
   if (!result.used_still) return nullptr;
   nlohmann::json backdrops = nlohmann::json::array();
@@ -93,13 +94,15 @@ nlohmann::json StillJson(const vision::Dataset& dataset, const solver::ShapeInit
                          {"spread", backdrop.spread},
                          {"sure_pixels", backdrop.sure_pixels}});
   }
+  if (result.used_backdrop)  // the photo-consistency did not run
+    return {{"method", "backdrop"}, {"backdrops", backdrops}, {"seconds", result.backdrop_seconds}};
   nlohmann::json cameras = nlohmann::json::array();
   for (const vision::StillCameraReport& camera : result.still.cameras)
     cameras.push_back({{"name", camera.name}, {"planes", camera.planes}, {"depth_pixels", camera.depth_pixels},
                        {"trusted_pixels", camera.trusted_pixels}, {"support_pixels", camera.support_pixels},
                        {"silhouette_pixels", camera.silhouette_pixels}, {"sweep_seconds", camera.sweep_seconds}});
   const vision::SupportPlane& plane = result.still.support;
-  return {{"method", result.used_backdrop ? "backdrop" : "photo-consistency"},
+  return {{"method", "photo-consistency"},
           {"backdrops", backdrops},
           {"support_plane", {{"found", plane.found}, {"normal", Vector3(plane.normal)}, {"offset", plane.offset},
                              {"tolerance", plane.tolerance}, {"inliers", plane.inliers}, {"points", plane.points},

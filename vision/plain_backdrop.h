@@ -13,13 +13,16 @@
 //   colour  c = the per-channel median of the band's pixels,
 //   spread  s = the spread_quantile-quantile of max_channel |I(p) − c| over them.
 // The backdrop is plain when s ≤ max_spread: an object or a prop covering less than
-// 1 − spread_quantile of the band leaves both figures unchanged, and a textured room (the
+// 1 − spread_quantile of the band moves both figures only within the backdrop's own
+// distribution (the spread becomes a higher percentile of its noise), and a textured room (the
 // synthetic scenes' walls and floors: s of 0.17 and more) or a cluttered lab is not plain.
 // Not the pixels outside the projected working volume, though they surely show no object:
 // what lies there (the Middlebury temple's lit cloth below a tight box) is background
 // whatever its look, and would make a plain backdrop look textured. A backdrop with a
 // lighting gradient beyond max_spread is not plain either; the set then keeps the
-// photo-consistency.
+// photo-consistency. Unlike the photo-consistency, nothing here removes a support plane:
+// a table top or turntable that differs from the backdrop is part of the silhouettes
+// wherever the working volume holds it.
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -227,13 +227,14 @@ std::vector<vision::Silhouette> StandingSilhouettes(const std::vector<vision::Es
 //    backdrop fits a shadow's gain as well as a shadow does, and was carved away (a
 //    sphere's shaded side); a shadow cast on the backdrop now stays in the silhouette,
 //    which only makes the hull larger.
-// Empty when some camera's backdrop is not plain (result->backdrops has every camera's
-// figures either way).
+// Empty when some camera's backdrop is not plain, or when some camera's silhouette is empty
+// (result->backdrops has every camera's figures either way).
 std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& dataset, int reference,
                                                     const std::vector<vision::Camera>& cameras,
                                                     const ShapeInitOptions& options, ShapeInitResult* result) {
   const vision::PlainBackdropOptions& backdrop = options.still.backdrop;
   if (!backdrop.enabled) return {};
+  const Stopwatch start;
   std::vector<cv::Mat> images(cameras.size());
   result->backdrops.assign(cameras.size(), vision::PlainBackdrop());
   tbb::parallel_for(0, static_cast<int>(cameras.size()), [&](int k) {
@@ -244,7 +245,7 @@ std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& datas
   if (!std::all_of(result->backdrops.begin(), result->backdrops.end(), plain)) {
     const auto widest = std::max_element(result->backdrops.begin(), result->backdrops.end(),
                                          [](const auto& a, const auto& b) { return a.spread < b.spread; });
-    spdlog::info("no plain backdrop ({} of {} cameras; widest spread {:.3f} > {:.3f} in camera {})",
+    spdlog::info("no plain backdrop (plain in {} of {} cameras; widest spread {:.3f} > {:.3f} in camera {})",
                  std::count_if(result->backdrops.begin(), result->backdrops.end(), plain), cameras.size(),
                  widest->spread, backdrop.max_spread, dataset.camera(widest - result->backdrops.begin()).name());
     return {};
@@ -257,6 +258,13 @@ std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& datas
         images[k], vision::BackdropImage(images[k], result->backdrops[k]), plain_options);
     silhouettes[k].source = vision::EvidenceSource::kStill;
   });
+  result->backdrop_seconds = start.Seconds();
+  const auto empty = std::find_if(silhouettes.begin(), silhouettes.end(), [](const auto& s) { return s.empty; });
+  if (empty != silhouettes.end()) {  // an object of the backdrop's colour (dark on black velvet)?
+    spdlog::info("nothing differs from the plain backdrop in camera {}: photo-consistency instead",
+                 dataset.camera(empty - silhouettes.begin()).name());
+    return {};
+  }
   result->used_backdrop = true;
   double spread = 0;
   for (const vision::PlainBackdrop& b : result->backdrops) spread = std::max(spread, b.spread);
@@ -460,7 +468,7 @@ ShapeInitResult InitializeShape(const vision::Dataset& dataset, const ShapeInitO
   if (result.used_still && std::find(has_evidence.begin(), has_evidence.end(), true) == has_evidence.end())
     ThrowError(dataset.directory(), "evidence",
                std::string("no masks, no background, nothing moves, and ") +
-                   (result.used_backdrop ? "nothing differs from the plain backdrop"
+                   (result.used_backdrop ? "the differences to the plain backdrop carve the whole volume"
                                          : "the photo-consistency of the still set found no surface either") +
                    " (evidence \"still\"): cannot find the object (give masks or background images)");
   TakeHullsOfFramesWithoutEvidence(dataset, has_evidence, all_empty, options.carving.min_cameras, &result.frames,

@@ -46,8 +46,10 @@ struct ShapeInitOptions {
   vision::StandingEvidenceOptions standing;
   // When no frame has any evidence (no masks, no background images, nothing moves: a
   // still set of one frame, or a take in which nobody moves), or with silhouettes.source
-  // kStill: the photo-consistency of the still set formed by the reference frame of every
-  // camera (vision/still_evidence.h) is every frame's evidence.
+  // kStill: the still set formed by the reference frame of every camera is every frame's
+  // evidence: its differences to a plain backdrop when every camera has one
+  // (vision/plain_backdrop.h, still.backdrop), else its photo-consistency
+  // (vision/still_evidence.h).
   vision::StillEvidenceOptions still;
   vision::VoxelCarvingOptions carving;
   // Every frame's hull is carved where the cameras see through it (concavities the
@@ -154,6 +156,7 @@ struct ShapeInitResult {
   bool used_still = false;
   bool used_backdrop = false;
   std::vector<vision::PlainBackdrop> backdrops;
+  double backdrop_seconds = 0;  // measuring the backdrops and their silhouettes
   vision::StillEvidence still;
   // Per camera, the scale of the images the evidence was computed on (1 = stored size;
   // VoxelCarvingOptions::max_pixels_per_voxel).

@@ -301,6 +301,22 @@ TEST(MotionInit, FlagsADuplicatedFrameAndKeepsTheSurfaceStill) {
   EXPECT_LT(repeated, 0.02 * true_step);
 }
 
+// A still (one frame) has no step: its trajectory is the reference control points, exactly,
+// and no image is read (the loader would throw).
+TEST(MotionInit, OneFrameIsTheReferenceShapeAndReadsNoImage) {
+  const MotionTestScene& scene = Scene();
+  const vision::ImageSequence images{scene.cameras, 0, 1, [](int, int) -> cv::Mat {
+                                       throw std::runtime_error("an image of a still was read");
+                                     }, {}, {}};
+  const MotionInitResult result = InitializeMotion(images, scene.hierarchy, {scene.control}, 0, MotionInitOptions());
+  ASSERT_EQ(result.control.size(), 1u);
+  EXPECT_EQ(result.control[0], scene.control);
+  ASSERT_EQ(result.frames.size(), 1u);
+  EXPECT_EQ(result.frames[0].frame, 0);
+  EXPECT_EQ(result.frames[0].from_frame, -1);
+  EXPECT_EQ(result.reference_frame, 0);
+}
+
 TEST(MotionInit, RejectsInconsistentInputs) {
   const MotionTestScene& scene = Scene();
   const vision::ImageSequence images{scene.cameras, 0, 3, [](int, int) { return cv::Mat(); }, {}, {}};

@@ -379,8 +379,9 @@ TEST(ShapeInit, BackgroundEstimatedFromTheVideoGivesBetterSilhouettesThanMotionE
 // A still set of one frame without masks or background, photographed against a plain
 // backdrop (the synthetic scenes' dark one): every camera's backdrop is found plain and the
 // hull is carved from the differences to its colour, as close to the sphere as the hull of
-// the masks. Without the backdrop (photo-consistency, vision/still_evidence.h) this set is
-// unreadable: see the next test.
+// the masks. (Without the backdrop, the photo-consistency of vision/still_evidence.h reads
+// such sets badly or not at all: the next test, and docs/shape.md, "Still sets on a plain
+// backdrop".)
 TEST(ShapeInit, StillSetOnAPlainBackdropIsCarvedFromTheBackdropsColour) {
   const fs::path directory = Scratch().FreshPath("still_backdrop");
   vision::WriteSyntheticDataset(directory.string(), SphereOptions("dome", 10, 160, 120, 1));
@@ -393,11 +394,7 @@ TEST(ShapeInit, StillSetOnAPlainBackdropIsCarvedFromTheBackdropsColour) {
   ASSERT_TRUE(result.used_still);
   ASSERT_TRUE(result.used_backdrop);
   ASSERT_EQ(result.backdrops.size(), 10u);
-  for (const vision::PlainBackdrop& backdrop : result.backdrops) {
-    EXPECT_TRUE(backdrop.plain);
-    EXPECT_LE(backdrop.spread, 0.03);
-    EXPECT_GT(backdrop.sure_pixels, 0);
-  }
+  for (const vision::PlainBackdrop& backdrop : result.backdrops) EXPECT_TRUE(backdrop.plain);
   const FrameShapeInit& frame = result.frames.at(0);
   EXPECT_EQ(frame.carving.cameras.front().source, vision::EvidenceSource::kStill);
   const double voxel = VoxelSize(dataset, frame);

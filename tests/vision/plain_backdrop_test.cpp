@@ -15,8 +15,8 @@ namespace {
 constexpr int kWidth = 160, kHeight = 120;
 
 // A dark backdrop (BGR 12, 10, 8) with sensor noise (σ = 2 levels), a bright object in the
-// middle, and a second bright region reaching into the top border band over a fifth of
-// the band's length.
+// middle, and a second bright region reaching into the top border band (96 of the 3-px
+// band's 1,644 pixels).
 cv::Mat DarkBackdropWithObjects() {
   cv::Mat image(kHeight, kWidth, CV_8UC3, cv::Scalar(12, 10, 8));
   cv::Mat noise(kHeight, kWidth, CV_16SC3);
@@ -50,6 +50,32 @@ TEST(PlainBackdrop, DarkBackdropIsPlainWithItsColourDespiteAnObjectInTheBand) {
   const cv::Mat image = BackdropImage(DarkBackdropWithObjects(), backdrop);
   ASSERT_EQ(image.type(), CV_32FC3);
   EXPECT_NEAR(image.at<cv::Vec3f>(60, 80)[0], backdrop.colour[0], 1e-6);
+}
+
+TEST(PlainBackdrop, AnObjectOnAThirdOfTheBandLeavesTheBackdropPlain) {
+  // A textured object over the whole top edge and down the sides: 552 of the 1,644 band
+  // pixels (34 %, under the 40 % the 60th percentile tolerates).
+  cv::Mat image = DarkBackdropWithObjects();
+  cv::randu(image(cv::Rect(0, 0, kWidth, 15)), 60, 250);
+  const PlainBackdrop backdrop = MeasureBackdrop(image, Band(3));
+  EXPECT_TRUE(backdrop.plain) << backdrop.spread;
+  EXPECT_NEAR(backdrop.colour[0], 12 / 255.0, 2.5 / 255);
+}
+
+TEST(PlainBackdrop, GraySixteenBitAndAlphaImagesAreReadInUnitsOfTheirRange) {
+  cv::Mat gray(kHeight, kWidth, CV_16UC1, cv::Scalar(0.2 * 65535));
+  cv::circle(gray, {80, 60}, 30, cv::Scalar(60000), cv::FILLED);
+  const PlainBackdrop from_gray = MeasureBackdrop(gray, Band(3));
+  EXPECT_TRUE(from_gray.plain);
+  EXPECT_EQ(from_gray.channels, 1);
+  EXPECT_NEAR(from_gray.colour[0], 0.2, 1e-4);
+  EXPECT_EQ(BackdropImage(gray, from_gray).type(), CV_32FC1);
+  cv::Mat bgra(kHeight, kWidth, CV_8UC4, cv::Scalar(40, 50, 60, 255));
+  const PlainBackdrop from_bgra = MeasureBackdrop(bgra, Band(3));
+  EXPECT_TRUE(from_bgra.plain);
+  EXPECT_EQ(from_bgra.channels, 3);  // alpha dropped
+  EXPECT_NEAR(from_bgra.colour[2], 60 / 255.0, 1e-6);
+  EXPECT_EQ(BackdropImage(bgra, from_bgra).type(), CV_32FC3);
 }
 
 TEST(PlainBackdrop, TexturedBackdropIsNotPlain) {
