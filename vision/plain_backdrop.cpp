@@ -69,8 +69,7 @@ PlainBackdrop MeasureBackdrop(const cv::Mat& image, const cv::Mat& sure, const P
 }
 
 cv::Mat BackdropImage(const cv::Mat& image, const PlainBackdrop& backdrop) {
-  const int channels = image.channels() == 4 ? 3 : image.channels();
-  return cv::Mat(image.size(), CV_MAKETYPE(CV_32F, channels), backdrop.colour);
+  return cv::Mat(image.size(), CV_MAKETYPE(CV_32F, backdrop.channels), backdrop.colour);
 }
 
 }  // namespace subflow::vision

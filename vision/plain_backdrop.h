@@ -54,8 +54,8 @@ cv::Mat BorderBand(cv::Size size, const PlainBackdropOptions& options = {});
 // Not plain when `sure` has no pixel.
 PlainBackdrop MeasureBackdrop(const cv::Mat& image, const cv::Mat& sure, const PlainBackdropOptions& options = {});
 
-// The backdrop as a background image: `colour` everywhere, CV_32F with the channels of
-// `image` (alpha dropped), `image`'s size.
+// The backdrop as a background image: `colour` everywhere, CV_32F with the backdrop's
+// channels (those MeasureBackdrop read on `image`), `image`'s size.
 cv::Mat BackdropImage(const cv::Mat& image, const PlainBackdrop& backdrop);
 
 }  // namespace subflow::vision

@@ -242,9 +242,9 @@ std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& datas
     result->backdrops[k] = vision::MeasureBackdrop(images[k], vision::BorderBand(images[k].size(), backdrop), backdrop);
   });
   const auto plain = [](const vision::PlainBackdrop& b) { return b.plain; };
+  const auto widest = std::max_element(result->backdrops.begin(), result->backdrops.end(),
+                                       [](const auto& a, const auto& b) { return a.spread < b.spread; });
   if (!std::all_of(result->backdrops.begin(), result->backdrops.end(), plain)) {
-    const auto widest = std::max_element(result->backdrops.begin(), result->backdrops.end(),
-                                         [](const auto& a, const auto& b) { return a.spread < b.spread; });
     spdlog::info("no plain backdrop (plain in {} of {} cameras; widest spread {:.3f} > {:.3f} in camera {})",
                  std::count_if(result->backdrops.begin(), result->backdrops.end(), plain), cameras.size(),
                  widest->spread, backdrop.max_spread, dataset.camera(widest - result->backdrops.begin()).name());
@@ -266,11 +266,9 @@ std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& datas
     return {};
   }
   result->used_backdrop = true;
-  double spread = 0;
-  for (const vision::PlainBackdrop& b : result->backdrops) spread = std::max(spread, b.spread);
   spdlog::info("no masks, no background and nothing moves: frame {} against a plain backdrop in every camera "
                "(widest spread {:.3f})",
-               reference, spread);
+               reference, widest->spread);
   return silhouettes;
 }
 

@@ -138,6 +138,23 @@ double MeanExcess(const vision::Dataset& dataset, const FrameShapeInit& frame) {
   return ((frame.hull.V.rowwise() - sphere.centre.transpose()).rowwise().norm().array() - sphere.radius).mean();
 }
 
+// The claim of a hull from measured silhouettes against the hull of the masks (the test
+// below says why these bounds): it contains the sphere, its Hausdorff distance is ≤ 3
+// voxels, and its mean excess over the sphere ≤ 1.5 × the masks' plus a quarter voxel.
+void ExpectAsCloseAsTheMaskHull(const vision::Dataset& dataset, const FrameShapeInit& frame,
+                                const vision::Dataset& with_masks, const FrameShapeInit& mask_frame,
+                                const char* what) {
+  const double voxel = VoxelSize(dataset, frame);
+  const double hausdorff = ExpectContainsTruthAndHausdorff(dataset, frame, 0.005);
+  const double excess = MeanExcess(dataset, frame), mask_excess = MeanExcess(with_masks, mask_frame);
+  std::printf("[ figures ] frame %d: %s hull: Hausdorff %.2f voxels, mean excess %.3f voxels (masks: %.3f), "
+              "mean silhouette IoU %.4f\n",
+              frame.frame, what, hausdorff / voxel, excess / voxel, mask_excess / voxel,
+              frame.carving.mean_silhouette_iou);
+  EXPECT_LE(hausdorff, 3.0 * voxel) << what << ", frame " << frame.frame;
+  EXPECT_LE(excess, 1.5 * mask_excess + 0.25 * voxel) << what << ", frame " << frame.frame;
+}
+
 // Without masks, the background difference gives a hull as close as the masks' (the
 // silhouettes match the masks to ~½ pixel, and the strict hull, max_misses = 0, is carved
 // from them): same claim (contains the sphere, Hausdorff ≤ 3 voxels), and a mean excess
@@ -164,14 +181,7 @@ TEST(ShapeInit, HullFromPlainBackgroundDifferenceIsAsCloseAsTheHullFromMasks) {
     const FrameShapeInit& frame = result.frames[i];
     ASSERT_EQ(frame.carving.cameras.front().source, vision::EvidenceSource::kBackground);
     EXPECT_EQ(frame.carving.max_misses, 0);
-    const double voxel = VoxelSize(dataset, frame);
-    const double hausdorff = ExpectContainsTruthAndHausdorff(dataset, frame, 0.005);
-    const double excess = MeanExcess(dataset, frame), mask_excess = MeanExcess(with_masks, from_masks.frames[i]);
-    std::printf("[ figures ] frame %d: background hull: Hausdorff %.2f voxels, mean excess %.3f voxels (masks: %.3f), "
-                "mean silhouette IoU %.4f\n",
-                frame.frame, hausdorff / voxel, excess / voxel, mask_excess / voxel, frame.carving.mean_silhouette_iou);
-    EXPECT_LE(hausdorff, 3.0 * voxel) << "frame " << frame.frame;
-    EXPECT_LE(excess, 1.5 * mask_excess + 0.25 * voxel) << "frame " << frame.frame;
+    ExpectAsCloseAsTheMaskHull(dataset, frame, with_masks, from_masks.frames[i], "background");
   }
 }
 
@@ -397,13 +407,7 @@ TEST(ShapeInit, StillSetOnAPlainBackdropIsCarvedFromTheBackdropsColour) {
   for (const vision::PlainBackdrop& backdrop : result.backdrops) EXPECT_TRUE(backdrop.plain);
   const FrameShapeInit& frame = result.frames.at(0);
   EXPECT_EQ(frame.carving.cameras.front().source, vision::EvidenceSource::kStill);
-  const double voxel = VoxelSize(dataset, frame);
-  const double hausdorff = ExpectContainsTruthAndHausdorff(dataset, frame, 0.005);
-  const double excess = MeanExcess(dataset, frame), mask_excess = MeanExcess(with_masks, from_masks.frames[0]);
-  std::printf("[ figures ] still on a plain backdrop: Hausdorff %.2f voxels, mean excess %.3f voxels (masks: %.3f)\n",
-              hausdorff / voxel, excess / voxel, mask_excess / voxel);
-  EXPECT_LE(hausdorff, 3.0 * voxel);
-  EXPECT_LE(excess, 1.5 * mask_excess + 0.25 * voxel);
+  ExpectAsCloseAsTheMaskHull(dataset, frame, with_masks, from_masks.frames[0], "plain backdrop");
 }
 
 // A still set that neither the backdrop (here turned off: the synthetic backdrop is plain)
