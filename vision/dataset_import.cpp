@@ -14,6 +14,11 @@ namespace subflow::vision {
 namespace fs = std::filesystem;
 namespace {
 
+// Video encoders code whole blocks of 16×16 pixels: a 1080-row video is coded as 1088 rows, and
+// tools disagree on whether the padding is cut (a Qualisys calibration of 1088 columns, the
+// same camera's video re-encoded with 1080).
+constexpr int kCodecBlock = 16;
+
 std::string Size(int width, int height) { return std::to_string(width) + "×" + std::to_string(height); }
 
 std::string Lower(std::string text) {
@@ -21,21 +26,31 @@ std::string Lower(std::string text) {
   return text;
 }
 
-// The calibrated size against the decoded one (see the header).
-double FitSizeToMedia(CalibratedCamera* camera, const CameraMedia& media) {
+// The calibrated size against the decoded one (see the header): the scale s applied to K, or
+// 1; `note` says what was assumed when the sizes differ.
+double FitSizeToMedia(CalibratedCamera* camera, const CameraMedia& media, std::string* note) {
   if (camera->width <= 0 || camera->height <= 0) {
     camera->width = media.width;
     camera->height = media.height;
     return 1;
   }
   if (camera->width == media.width && camera->height == media.height) return 1;
+  const std::string calibrated = Size(camera->width, camera->height), decoded = Size(media.width, media.height);
   const double sx = static_cast<double>(media.width) / camera->width;
   const double sy = static_cast<double>(media.height) / camera->height;
   if (std::abs(sx - sy) > 1e-9) {
+    if (std::abs(media.width - camera->width) < kCodecBlock && std::abs(media.height - camera->height) < kCodecBlock) {
+      *note = "camera \"" + camera->name + "\": its " + decoded + " frames read as the calibrated " + calibrated +
+              " image cut or padded at the right and bottom edges (codec block padding), intrinsics unchanged";
+      camera->width = media.width;
+      camera->height = media.height;
+      return 1;
+    }
     const bool rotated = camera->width == media.height && camera->height == media.width;
     ThrowError(media.files.front(), "size",
-               "expected " + Size(camera->width, camera->height) + " (calibration of camera \"" + camera->name +
-                   "\") or a uniform scaling of it, got " + Size(media.width, media.height) +
+               "expected " + calibrated + " (calibration of camera \"" + camera->name +
+                   "\"), a uniform scaling of it, or it within " + std::to_string(kCodecBlock - 1) +
+                   " pixels on each axis (codec padding), got " + decoded +
                    (rotated ? " (rotated by 90°: store the video as calibrated)" : ""));
   }
   Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
@@ -44,6 +59,8 @@ double FitSizeToMedia(CalibratedCamera* camera, const CameraMedia& media) {
   camera->K = S * camera->K;
   camera->width = media.width;
   camera->height = media.height;
+  *note = "camera \"" + camera->name + "\": intrinsics scaled by " + std::to_string(sx) + " to its " + decoded +
+          " frames";
   return sx;
 }
 
@@ -183,11 +200,9 @@ DatasetImportResult ImportDataset(const Calibration& source_calibration, const s
   }
   std::vector<double> rescaled(calibration.cameras.size(), 1.0);
   for (std::size_t c = 0; c < media.size(); ++c) {
-    rescaled[c] = FitSizeToMedia(&calibration.cameras[c], media[c]);
-    if (rescaled[c] != 1)
-      result.notes.push_back("camera \"" + calibration.cameras[c].name + "\": intrinsics scaled by " +
-                             std::to_string(rescaled[c]) + " to its " + Size(media[c].width, media[c].height) +
-                             " frames");
+    std::string note;
+    rescaled[c] = FitSizeToMedia(&calibration.cameras[c], media[c], &note);
+    if (!note.empty()) result.notes.push_back(note);
     ProgressUpdate(progress, c + 1);
   }
   ProgressEnd(progress);

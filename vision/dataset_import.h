@@ -9,7 +9,10 @@
 // Frames are never re-encoded. Sizes: a calibrated size equal to the decoded one is kept;
 // a decoded size that is the calibrated one times s (the same s on both axes, e.g. a
 // binned or downscaled video) rescales K (fx, fy by s; cx' = s (cx + ½) − ½, pixel-centre
-// convention); any other size is an error; an unknown calibrated size is the decoded one.
+// convention); a decoded size within 15 pixels of the calibrated one on each axis (codec
+// block padding, cut or added: 1080 against 1088) is the same pixel grid cut or padded at
+// the right and bottom edges, K unchanged, with a note; any other size is an error; an
+// unknown calibrated size is the decoded one.
 //
 // Working volume ("bounds"): the one given, else the box of the region that at least
 // min_camera_fraction of the cameras see (vision/working_volume.h), clipped to the half

@@ -1,6 +1,7 @@
 // Claims about `subflow import`: a calibration and a folder of per-camera images become a
 // dataset that vision::Dataset opens, with the frames linked (not re-encoded) and
-// report.json written; images at a uniform scale of the calibrated size rescale K; an
+// report.json written; images at a uniform scale of the calibrated size rescale K, images a
+// few pixels off it (codec padding) keep it; an
 // existing dataset is not overwritten without --overwrite; a camera without images is an
 // error naming it (or left out with --skip-unmatched); and the shared Qualisys take
 // imports with its 4 videos.
@@ -108,6 +109,35 @@ TEST(ImportCommand, HalfSizeImagesRescaleTheIntrinsics) {
   EXPECT_NEAR(dataset.camera(0).K()(0, 0), rig[0].K(0, 0) / 2, 1e-12);
   EXPECT_NEAR(dataset.camera(0).K()(0, 2), (rig[0].K(0, 2) + 0.5) / 2 - 0.5, 1e-12);  // pixel centres
   EXPECT_NE(run.out.find("intrinsics scaled by 0.5"), std::string::npos) << run.output();
+}
+
+// A video coded in 16-pixel blocks: the calibration says 1088 columns, the re-encoded video
+// has 1080 (Pose2Sim's single-person demo). Within 15 pixels the frames are the calibrated
+// grid cut or padded at the right and bottom edges: K is kept. Beyond, and not a uniform
+// scale, it is an error naming the image and the size.
+TEST(ImportCommand, FramesCutByCodecPaddingKeepTheIntrinsics) {
+  const auto rig = test::RingRig(2, 2.0, 1.5, Eigen::Vector3d::UnitZ(), 168, 120, 150);
+  const fs::path dir = Scratch().Subdirectory("padding");
+  WriteToml(rig, dir / "Calib.toml");
+  WriteImages(rig, 2, 160, 120, dir / "frames");
+  const test::CommandResult run = test::RunSubflow("import toml " + Quoted(dir / "Calib.toml") + " --images " +
+                                                       Quoted(dir / "frames") + " --out " + Quoted(dir / "d"),
+                                                   dir);
+  ASSERT_EQ(run.exit_code, 0) << run.output();
+  const vision::Dataset dataset((dir / "d").string());
+  EXPECT_EQ(dataset.camera(0).width(), 160);
+  EXPECT_EQ(dataset.camera(0).height(), 120);
+  EXPECT_EQ(dataset.camera(0).K(), rig[0].K);
+  EXPECT_NE(run.out.find("codec block padding"), std::string::npos) << run.output();
+
+  WriteImages(rig, 2, 148, 120, dir / "narrow");
+  const test::CommandResult narrow = test::RunSubflow("import toml " + Quoted(dir / "Calib.toml") + " --images " +
+                                                          Quoted(dir / "narrow") + " --out " + Quoted(dir / "e"),
+                                                      dir);
+  EXPECT_EQ(narrow.exit_code, 1);
+  EXPECT_NE(narrow.err.find("img_8.jpg: size: expected 168×120"), std::string::npos) << narrow.output();
+  EXPECT_NE(narrow.err.find("got 148×120"), std::string::npos) << narrow.output();
+  EXPECT_FALSE(fs::exists(dir / "e" / "cameras.json"));
 }
 
 TEST(ImportCommand, ACameraWithoutImagesIsAnErrorUnlessSkipped) {
