@@ -234,6 +234,7 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
                       {"corrected", f.corrected},
                       {"correction_rms_before", f.correction_rms_before},
                       {"correction_rms_applied", f.correction_rms_applied},
+                      {"correction_unreached", f.correction_unreached},
                       {"seconds", f.step.seconds}});
     if (f.corrected && o.registration.enabled) frames.back()["registration"] = RegistrationJson(f.registration);
     if (o.guess_from_targets && f.from_frame >= 0)

@@ -1,8 +1,11 @@
 #include "output/stage_pipeline.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
+#include <string>
 
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include "core/error.h"
@@ -29,6 +32,31 @@ nlohmann::json OptionsOf(const solver::ReconstructionOptions& options, Stage sta
     case Stage::kRetrack: return options.RetrackOptions();
   }
   return nullptr;
+}
+
+// A quarter of the surface out of the correction's reach: the chain has left its targets
+// there (a limb left behind on a take with large motion: docs/shape.md, "The retrack on a
+// take with large motion"). Pose2Sim's single-person demo: up to 55 % far from the
+// reference frame; the synthetic scenes 0–0.1 % but take_small, 28 % at its last frame.
+constexpr double kOffTargetFraction = 0.25;
+
+void WarnOffTarget(Stage stage, const solver::MotionInitResult& figures, int first_frame) {
+  const std::vector<int> off = figures.FramesOffTarget(kOffTargetFraction);
+  if (off.empty()) return;
+  double most = 0.0;
+  for (const solver::MotionFrameReport& frame : figures.frames) most = std::max(most, frame.correction_unreached);
+  const bool retrack = stage == Stage::kRetrack;
+  const std::string frames = off.size() == 1 ? std::to_string(first_frame + off.front())
+                                             : fmt::format("{}–{}", first_frame + off.front(), first_frame + off.back());
+  spdlog::warn(
+      "{}: in {} of {} frames ({}) more than {:.0f} % of the surface is out of the correction's reach of the "
+      "frame's {} (up to {:.0f} %; report.json: {}.frames[].correction_unreached): the tracked surface left it "
+      "there, e.g. a limb far from the reference frame{}",
+      retrack ? "retrack" : "motion init", off.size(), figures.frames.size(), frames, 100 * kOffTargetFraction,
+      retrack ? "refined surface" : "hull fit", 100 * most, StageSection(stage),
+      retrack ? " (the refine stage's own surfaces, with a poorer flow: `subflow split DATASET --from <refine "
+                "stage folder> --out R`)"
+              : "");
 }
 
 // Runs the solver stage and returns its state; *section gets its figures for the report.
@@ -59,6 +87,7 @@ solver::StageState RunSolverStage(Stage stage, const vision::Dataset& dataset,
   solver::StageState state = solver::RunMotionStage(dataset, in->state, motion, progress, &figures);
   *section = MotionInitJson(motion, figures, state.first_frame);
   *brief = (stage == Stage::kRetrack ? "retrack: " : "") + figures.BriefReport();
+  WarnOffTarget(stage, figures, state.first_frame);
   return state;
 }
 

@@ -1,5 +1,6 @@
 #include "solver/motion/motion_init.h"
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <string>
@@ -32,6 +33,14 @@ std::string MotionInitResult::BriefReport() const {
   return fmt::format("motion init: {} frames from reference {}, photometric RMS {:.4f} (zero motion) → {:.4f}, {:.1f} s",
                      frames.size(), reference_frame, steps ? zero / steps : 0.0, steps ? estimated / steps : 0.0,
                      seconds);
+}
+
+std::vector<int> MotionInitResult::FramesOffTarget(double fraction) const {
+  std::vector<int> off;
+  for (const MotionFrameReport& frame : frames)
+    if (frame.corrected && frame.correction_unreached > fraction) off.push_back(frame.frame);
+  std::sort(off.begin(), off.end());
+  return off;
 }
 
 namespace {
@@ -115,6 +124,9 @@ Positions CorrectTowardsFit(const geometry::LoopHierarchy& hierarchy, const Surf
   report->corrected = true;
   report->correction_rms_before = snap_report.rms_distance_before;
   report->correction_rms_applied = snap_report.rms_correction;
+  report->correction_unreached = control.rows() > 0 ? static_cast<double>(snap_report.vertices_without_hit) /
+                                                          static_cast<double>(control.rows())
+                                                    : 0.0;
   return corrected;
 }
 

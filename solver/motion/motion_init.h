@@ -74,6 +74,10 @@ struct MotionFrameReport {
   bool corrected = false;           // normal correction applied
   double correction_rms_before = 0.0;   // RMS normal distance to the frame's fitted surface
   double correction_rms_applied = 0.0;  // RMS length of the correction applied to the control points
+  // Fraction of the finest limit points whose normal line meets the frame's fitted surface
+  // nowhere within the correction's reach (first pass): surface that the correction cannot
+  // bring back, e.g. a limb the chain left behind.
+  double correction_unreached = 0.0;
   SurfaceRegistrationReport registration;  // measured whenever corrected; `applied` when registered
 };
 
@@ -85,6 +89,9 @@ struct MotionInitResult {
 
   // One line: frames, reference, photometric RMS of zero motion → estimated, seconds.
   std::string BriefReport() const;
+  // The frames where more than `fraction` of the surface was beyond the correction's reach
+  // of the frame's fitted surface (correction_unreached), in order.
+  std::vector<int> FramesOffTarget(double fraction) const;
 };
 
 // One step's correction towards its frame's fitted surface `fit` (see the file comment):

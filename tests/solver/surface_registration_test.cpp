@@ -201,5 +201,38 @@ TEST(SurfaceRegistration, MotionCorrectionBringsADriftedLimbBackOntoItsFit) {
   EXPECT_EQ((on - off).cwiseAbs().maxCoeff(), 0.0);
 }
 
+// What the correction could not reach is reported (MotionFrameReport::correction_unreached):
+// of the straight limb's surface against the limb bent 35° at its knee, the part beyond the
+// knee that turned away (0.29 of the surface) has no fit within the snap's reach; against
+// the straight limb, all of it has.
+// MotionInitResult::FramesOffTarget lists the frames above a fraction, in order.
+TEST(SurfaceRegistration, MotionCorrectionReportsTheSurfaceOutOfItsReach) {
+  const BentLimb limb;
+  const Positions tracked =
+      FitHierarchyToSurface(limb.hierarchy, limb.base.V, geometry::ClosestPointTree(limb.straight),
+                            HierarchyFitOptions())
+          .back();
+  const double max_correction =
+      3.0 * geometry::MeanEdgeLength(limb.hierarchy.Topology(limb.hierarchy.finest_level()), tracked);
+  MotionInitOptions options;
+  const SurfaceRegistration registration(limb.hierarchy, options.registration);
+  MotionInitResult result;
+  result.frames.resize(3);
+  for (int f = 0; f < 3; ++f) result.frames[f].frame = f;
+  CorrectTowardsFit(limb.hierarchy, registration, tracked, geometry::ClosestPointTree(limb.bent, "bent limb"), options,
+                    max_correction, &result.frames[2]);
+  CorrectTowardsFit(limb.hierarchy, registration, tracked, geometry::ClosestPointTree(limb.straight, "straight limb"),
+                    options, max_correction, &result.frames[1]);
+  std::printf("[ figures ] out of reach: %.4f of the surface against the bent limb, %.4f against the straight\n",
+              result.frames[2].correction_unreached, result.frames[1].correction_unreached);
+  EXPECT_GT(result.frames[2].correction_unreached, 0.2);
+  EXPECT_LT(result.frames[2].correction_unreached, 0.5);
+  EXPECT_LT(result.frames[1].correction_unreached, 0.01);
+  EXPECT_EQ(result.FramesOffTarget(0.2), std::vector<int>{2});
+  EXPECT_TRUE(result.FramesOffTarget(0.9).empty());
+  result.frames[0].correction_unreached = 1.0;  // not corrected (the reference frame): not listed
+  EXPECT_EQ(result.FramesOffTarget(0.2), std::vector<int>{2});
+}
+
 }  // namespace
 }  // namespace subflow::solver
