@@ -28,6 +28,11 @@ const test::TemporaryDirectory& Scratch() {
 
 std::string Quoted(const fs::path& path) { return "'" + path.string() + "'"; }
 
+// `subflow import toml <dir>/Calib.toml --images <dir>/<images> --out <out>`.
+std::string ImportToml(const fs::path& dir, const std::string& images, const fs::path& out) {
+  return "import toml " + Quoted(dir / "Calib.toml") + " --images " + Quoted(dir / images) + " --out " + Quoted(out);
+}
+
 // A Pose2Sim Calib.toml of `rig` (exact numbers).
 void WriteToml(const std::vector<test::TruthCamera>& rig, const fs::path& path) {
   std::ofstream out(path);
@@ -61,8 +66,7 @@ TEST(ImportCommand, CalibrationAndImagesBecomeADatasetThatOpens) {
   WriteImages(rig, 3, 160, 120, dir / "frames");
   const fs::path out = dir / "dataset";
   const test::CommandResult run = test::RunSubflow(
-      "import toml " + Quoted(dir / "Calib.toml") + " --images " + Quoted(dir / "frames") + " --out " + Quoted(out) +
-          " --bounds -0.5,-0.5,0,0.5,0.5,1 --frames 2",
+      ImportToml(dir, "frames", out) + " --bounds -0.5,-0.5,0,0.5,0.5,1 --frames 2",
       dir);
   ASSERT_EQ(run.exit_code, 0) << run.output();
   const vision::Dataset dataset(out.string());
@@ -82,14 +86,10 @@ TEST(ImportCommand, CalibrationAndImagesBecomeADatasetThatOpens) {
     EXPECT_LT((dataset.camera(c).Center() - rig[c].Centre()).norm(), 1e-9);
 
   // Not again without --overwrite; with it, the dataset is replaced.
-  const test::CommandResult again = test::RunSubflow(
-      "import toml " + Quoted(dir / "Calib.toml") + " --images " + Quoted(dir / "frames") + " --out " + Quoted(out), dir);
+  const test::CommandResult again = test::RunSubflow(ImportToml(dir, "frames", out), dir);
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_NE(again.err.find("refusing to overwrite"), std::string::npos) << again.output();
-  const test::CommandResult replaced = test::RunSubflow(
-      "import toml " + Quoted(dir / "Calib.toml") + " --images " + Quoted(dir / "frames") + " --out " + Quoted(out) +
-          " --overwrite --link copy",
-      dir);
+  const test::CommandResult replaced = test::RunSubflow(ImportToml(dir, "frames", out) + " --overwrite --link copy", dir);
   ASSERT_EQ(replaced.exit_code, 0) << replaced.output();
   EXPECT_FALSE(fs::is_symlink(out / "images" / "cam02" / "000001.jpg"));
   EXPECT_EQ(vision::Dataset(out.string()).frame_count(), 3);
@@ -100,9 +100,7 @@ TEST(ImportCommand, HalfSizeImagesRescaleTheIntrinsics) {
   const fs::path dir = Scratch().Subdirectory("half");
   WriteToml(rig, dir / "Calib.toml");
   WriteImages(rig, 2, 80, 60, dir / "frames");
-  const test::CommandResult run = test::RunSubflow("import toml " + Quoted(dir / "Calib.toml") + " --images " +
-                                                       Quoted(dir / "frames") + " --out " + Quoted(dir / "d"),
-                                                   dir);
+  const test::CommandResult run = test::RunSubflow(ImportToml(dir, "frames", dir / "d"), dir);
   ASSERT_EQ(run.exit_code, 0) << run.output();
   const vision::Dataset dataset((dir / "d").string());
   EXPECT_EQ(dataset.camera(0).width(), 80);
@@ -120,9 +118,7 @@ TEST(ImportCommand, FramesCutByCodecPaddingKeepTheIntrinsics) {
   const fs::path dir = Scratch().Subdirectory("padding");
   WriteToml(rig, dir / "Calib.toml");
   WriteImages(rig, 2, 160, 120, dir / "frames");
-  const test::CommandResult run = test::RunSubflow("import toml " + Quoted(dir / "Calib.toml") + " --images " +
-                                                       Quoted(dir / "frames") + " --out " + Quoted(dir / "d"),
-                                                   dir);
+  const test::CommandResult run = test::RunSubflow(ImportToml(dir, "frames", dir / "d"), dir);
   ASSERT_EQ(run.exit_code, 0) << run.output();
   const vision::Dataset dataset((dir / "d").string());
   EXPECT_EQ(dataset.camera(0).width(), 160);
@@ -131,9 +127,7 @@ TEST(ImportCommand, FramesCutByCodecPaddingKeepTheIntrinsics) {
   EXPECT_NE(run.out.find("codec block padding"), std::string::npos) << run.output();
 
   WriteImages(rig, 2, 148, 120, dir / "narrow");
-  const test::CommandResult narrow = test::RunSubflow("import toml " + Quoted(dir / "Calib.toml") + " --images " +
-                                                          Quoted(dir / "narrow") + " --out " + Quoted(dir / "e"),
-                                                      dir);
+  const test::CommandResult narrow = test::RunSubflow(ImportToml(dir, "narrow", dir / "e"), dir);
   EXPECT_EQ(narrow.exit_code, 1);
   EXPECT_NE(narrow.err.find("img_8.jpg: size: expected 168×120"), std::string::npos) << narrow.output();
   EXPECT_NE(narrow.err.find("got 148×120"), std::string::npos) << narrow.output();
@@ -145,8 +139,7 @@ TEST(ImportCommand, ACameraWithoutImagesIsAnErrorUnlessSkipped) {
   const fs::path dir = Scratch().Subdirectory("missing");
   WriteToml(rig, dir / "Calib.toml");
   WriteImages(rig, 2, 160, 120, dir / "frames");
-  const std::string base =
-      "import toml " + Quoted(dir / "Calib.toml") + " --images " + Quoted(dir / "frames") + " --out " + Quoted(dir / "d");
+  const std::string base = ImportToml(dir, "frames", dir / "d");
   const test::CommandResult run = test::RunSubflow(base, dir);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("cam03"), std::string::npos) << run.output();

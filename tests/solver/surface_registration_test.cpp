@@ -55,10 +55,15 @@ struct BentLimb {
   geometry::LoopHierarchy hierarchy{base.F, base.vertex_count(), 2};
   geometry::TriangleMesh straight = Limb(5);
   geometry::TriangleMesh bent = Bent(Limb(5), 35.0);
-  // The base fitted to the straight limb: the previous frame's surface.
-  Positions fitted_base =
-      FitHierarchyToSurface(hierarchy, base.V, geometry::ClosestPointTree(straight), HierarchyFitOptions())
-          .front();
+  // The hierarchy fitted to the straight limb, level by level.
+  std::vector<Positions> straight_fit =
+      FitHierarchyToSurface(hierarchy, base.V, geometry::ClosestPointTree(straight), HierarchyFitOptions());
+  // Its base: the previous frame's surface.
+  Positions fitted_base = straight_fit.front();
+  // Its finest control points (with their details): a tracked surface.
+  Positions tracked = straight_fit.back();
+  // Motion initialization's default reach of the correction: 3 mean finest edges.
+  double max_correction = 3.0 * geometry::MeanEdgeLength(hierarchy.Topology(hierarchy.finest_level()), tracked);
 };
 
 // A limb turned by 35° at its knee: snapping the previous frame's surface along its normals
@@ -161,13 +166,9 @@ TEST(SurfaceRegistration, RejectsBadInputAndOptions) {
 // finest edges) leaves the turned half off; the registration before it brings it on.
 TEST(SurfaceRegistration, MotionCorrectionBringsADriftedLimbBackOntoItsFit) {
   const BentLimb limb;
-  const Positions tracked =
-      FitHierarchyToSurface(limb.hierarchy, limb.base.V, geometry::ClosestPointTree(limb.straight),
-                            HierarchyFitOptions())
-          .back();
+  const Positions& tracked = limb.tracked;
   const geometry::ClosestPointTree fit(limb.bent, "bent limb");
-  const double max_correction =
-      3.0 * geometry::MeanEdgeLength(limb.hierarchy.Topology(limb.hierarchy.finest_level()), tracked);
+  const double max_correction = limb.max_correction;
   const auto correct = [&](bool registration_enabled, MotionFrameReport* report) {
     MotionInitOptions options;
     options.registration.enabled = registration_enabled;
@@ -208,12 +209,8 @@ TEST(SurfaceRegistration, MotionCorrectionBringsADriftedLimbBackOntoItsFit) {
 // MotionInitResult::FramesOffTarget lists the frames above a fraction, in order.
 TEST(SurfaceRegistration, MotionCorrectionReportsTheSurfaceOutOfItsReach) {
   const BentLimb limb;
-  const Positions tracked =
-      FitHierarchyToSurface(limb.hierarchy, limb.base.V, geometry::ClosestPointTree(limb.straight),
-                            HierarchyFitOptions())
-          .back();
-  const double max_correction =
-      3.0 * geometry::MeanEdgeLength(limb.hierarchy.Topology(limb.hierarchy.finest_level()), tracked);
+  const Positions& tracked = limb.tracked;
+  const double max_correction = limb.max_correction;
   MotionInitOptions options;
   const SurfaceRegistration registration(limb.hierarchy, options.registration);
   MotionInitResult result;
