@@ -2,7 +2,7 @@
 //   subflow shape   DATASET --out S [--frames A:B] [shape options]     (also: hull)
 //   subflow motion  DATASET --from S --out M [--frames A:B] [motion options]
 //   subflow refine  DATASET --from M --out R [--frames A:B] [refinement options]
-//   subflow retrack DATASET --from R --out T [--frames A:B] [motion options, --retrack-weight, --retrack-highpass]
+//   subflow retrack DATASET --from R --out T [--frames A:B] [motion options, --retrack-weight, --retrack-highpass, --no-retrack-register]
 //   subflow split   DATASET --from T --out RESULT                      (the OUTPUT.md result)
 //   subflow merge   FOLDER... --out DIR     (stage folders of frame ranges → one)
 // Each runs output::RunStage, as reconstruct does.

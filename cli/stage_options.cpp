@@ -209,6 +209,9 @@ void AddRetrackOptions(CLI::App* sub, solver::ReconstructionOptions* o) {
                   "and shading removed, texture kept (0 = the raw intensities)")
       ->check(CLI::Range(0.0, solver::kMaxHighPassSigma))
       ->capture_default_str();
+  sub->add_flag("!--no-retrack-register", o->retrack_register,
+                "Do not register the second motion pass's frames that lost their refined surface (more than a "
+                "quarter of it out of reach, e.g. a limb left behind): snap only");
 }
 
 void AddReconstructionOptions(CLI::App* sub, ReconstructionArguments* arguments) {

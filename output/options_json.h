@@ -140,6 +140,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionStepOptions, sampling, vis
 // WITH_DEFAULT below too.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,
                                                 hull_iterations, registration, guess_from_targets,
+                                                spread_registration, registration_min_unreached,
                                                 concurrent_chains)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WindowSolverOptions, linear_solver, max_iterations, threads,
                                                 function_tolerance, iterative_from_unknowns, iterative_solver,
@@ -157,7 +158,7 @@ inline void to_json(nlohmann::json& json, const ReconstructionOptions& options) 
   json = {{"shape_init", options.shape},   {"motion_init", options.motion},
           {"refinement", options.refinement}, {"refine", options.refine},
           {"retrack", options.retrack},    {"retrack_weight", options.retrack_weight},
-          {"retrack_highpass", options.retrack_highpass}};
+          {"retrack_highpass", options.retrack_highpass}, {"retrack_register", options.retrack_register}};
 }
 inline void from_json(const nlohmann::json& json, ReconstructionOptions& options) {
   json.at("shape_init").get_to(options.shape);
@@ -169,6 +170,8 @@ inline void from_json(const nlohmann::json& json, ReconstructionOptions& options
   // Options files written before the retrack had its own high-pass have none: their retrack
   // ran on the first pass's (motion_init.step.highpass_sigma), and still does.
   options.retrack_highpass = json.value("retrack_highpass", options.motion.step.highpass_sigma);
+  // Those written before the retrack registered lost frames (2026-12-06) did not.
+  options.retrack_register = json.value("retrack_register", false);
 }
 
 }  // namespace subflow::solver

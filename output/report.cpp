@@ -236,7 +236,11 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
                       {"correction_rms_applied", f.correction_rms_applied},
                       {"correction_unreached", f.correction_unreached},
                       {"seconds", f.step.seconds}});
-    if (f.corrected && o.registration.enabled) frames.back()["registration"] = RegistrationJson(f.registration);
+    if (f.corrected && o.registration.enabled) {
+      frames.back()["registration"] = RegistrationJson(f.registration);
+      if (f.unreached_before_registration >= 0.0)
+        frames.back()["registration"]["unreached_before"] = f.unreached_before_registration;
+    }
     if (o.guess_from_targets && f.from_frame >= 0)
       frames.back()["guess"] = {{"used", f.step.guess_used},
                                 {"photometric_rms", f.step.guess_rms},

@@ -34,16 +34,13 @@ nlohmann::json OptionsOf(const solver::ReconstructionOptions& options, Stage sta
   return nullptr;
 }
 
-// A quarter of the refined surface out of the retrack's reach: the chain has left the
-// refined shapes there (a limb left behind on a take with large motion: docs/shape.md, "The
-// retrack on a take with large motion"). Pose2Sim's single-person demo: up to 55 % far from
-// the reference frame; the synthetic scenes 0–0.1 % but take_small, 28 % at its last frame.
-// The motion stage's targets, the per-frame hull fits, hold clutter on real takes (the
-// shared pose2sim take: over a quarter in 90 of 100 frames), so there the figure is only
-// reported.
-constexpr double kOffTargetFraction = 0.25;
-
+// Frames where a quarter of the refined surface stays out of the retrack's reach
+// (solver::kLostTargetFraction, after the retrack's registration): the chain has left the
+// refined shapes there (docs/shape.md, "The retrack on a take with large motion"). The motion
+// stage's targets, the per-frame hull fits, hold clutter on real takes (the shared pose2sim
+// take: over a quarter in 90 of 100 frames), so there the figure is only reported.
 void WarnRetrackOffTarget(const solver::MotionInitResult& figures, int first_frame) {
+  constexpr double kOffTargetFraction = solver::kLostTargetFraction;
   const std::vector<int> off = figures.FramesOffTarget(kOffTargetFraction);
   if (off.empty()) return;
   double most = 0.0;

@@ -31,7 +31,12 @@ MotionInitOptions ReconstructionOptions::RetrackOptions() const {
   // start was measured too and is worse (0.0580): the coarse pass stays.
   retrack.guess_from_targets = true;
   // The refined shapes share the trajectories' material points: nothing to register.
-  retrack.registration.enabled = false;
+  // A frame whose surface has lost its refined shape is registered to it, and the
+  // registration's displacement is spread over the frames since the last one registered
+  // (docs/shape.md, "The retrack on a take with large motion").
+  retrack.registration.enabled = retrack_register;
+  retrack.registration_min_unreached = kLostTargetFraction;
+  retrack.spread_registration = true;
   return retrack;
 }
 

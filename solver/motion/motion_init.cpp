@@ -64,6 +64,8 @@ void MotionInitOptions::Check() const {
   if (hull_iterations < 1 || hull_iterations > 20)
     ThrowError("motion init", "hull_iterations", "expected 1..20");
   registration.Check();
+  if (!(registration_min_unreached >= 0.0 && registration_min_unreached < 1.0))
+    ThrowError("motion init", "registration_min_unreached", "expected a fraction in [0, 1) (0 = no such gate)");
 }
 
 namespace {
@@ -99,19 +101,38 @@ bool CheckMotionInputs(const vision::ImageSequence& images, const geometry::Loop
   return per_frame;
 }
 
+// The displacement `shift` that a registration added at frame `to` built up since frame
+// `anchor` (the previous one registered, or the reference): the frames between take it in
+// proportion to their distance from the anchor, a steady motion instead of a jump at one
+// frame.
+void SpreadBack(const Positions& shift, int anchor, int to, std::vector<Positions>* control) {
+  const int direction = to > anchor ? 1 : -1;
+  const double span = std::abs(to - anchor);
+  for (int g = anchor + direction; g != to; g += direction)
+    (*control)[g] += (std::abs(g - anchor) / span) * shift;
+}
+
 }  // namespace
 
 Positions CorrectTowardsFit(const geometry::LoopHierarchy& hierarchy, const SurfaceRegistration& registration,
                             const Positions& control, const geometry::ClosestPointTree& fit,
-                            const MotionInitOptions& options, double max_correction, MotionFrameReport* report) {
+                            const MotionInitOptions& options, double max_correction, MotionFrameReport* report,
+                            Positions* registration_shift) {
   const int n = hierarchy.finest_level();
   Positions corrected = control;
-  if (options.registration.enabled) {
+  if (registration_shift) *registration_shift = Positions();
+  bool lost = true;
+  if (options.registration.enabled && options.registration_min_unreached > 0.0) {
+    report->unreached_before_registration = UnreachedFraction(hierarchy, n, control, fit, max_correction);
+    lost = report->unreached_before_registration > options.registration_min_unreached;
+  }
+  if (options.registration.enabled && lost) {
     geometry::MultiresShape shape = geometry::MultiresShape::Analyze(hierarchy, control);
     Positions registered = registration.Register(shape.base(), fit, &report->registration);
     if (report->registration.applied) {
       shape.base() = std::move(registered);
       corrected = shape.Synthesize(hierarchy, n);
+      if (registration_shift) *registration_shift = corrected - control;
     }
   }
   SurfaceSnapOptions snap;
@@ -179,8 +200,11 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   std::mutex progress_mutex;  // the two chains report one count
   int done = 0;
   ProgressBegin(progress, "motion initialization", static_cast<std::size_t>(frame_count - 1));
+  // Returns the registration's displacement of `to` when it was registered and
+  // options.spread_registration is set (else empty).
   auto propagate = [&](int from, int to, const std::vector<cv::Mat>& from_images,
                        const std::vector<cv::Mat>& to_images) {
+    Positions shift;
     const Positions* target = fitted(to);
     Positions guess;
     if (options.guess_from_targets && target) guess = *target - result.control[from];
@@ -199,7 +223,8 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     if (target && options.hull_weight > 0.0) {
       const geometry::ClosestPointTree tree(estimator.visibility().Tessellation(*target),
                                             "fitted surface of frame " + std::to_string(to));
-      control = CorrectTowardsFit(hierarchy, registration, control, tree, options, max_correction, &report);
+      control = CorrectTowardsFit(hierarchy, registration, control, tree, options, max_correction, &report,
+                                  options.spread_registration ? &shift : nullptr);
     }
     result.control[to] = std::move(control);
     spdlog::debug("motion init: frame {} -> {}: {} constraints, {} pruned, photometric rms {:.4f} "
@@ -207,16 +232,25 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
                   from, to, step.report.constraints, step.report.pruned,
                   step.report.photometric_rms_zero, step.report.photometric_rms,
                   step.report.mean_displacement, step.report.seconds);
-    const std::lock_guard<std::mutex> lock(progress_mutex);
-    ProgressUpdate(progress, static_cast<std::size_t>(++done));
+    {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      ProgressUpdate(progress, static_cast<std::size_t>(++done));
+    }
+    return shift;
   };
   const std::vector<cv::Mat> reference_images = load(reference_frame);
   // The chain from the reference frame to the last frame (direction +1) or to the first (-1).
   auto chain = [&](int direction) {
     std::vector<cv::Mat> current = reference_images;
+    int anchor = reference_frame;  // the last frame registered (or the reference)
     for (int f = reference_frame; f + direction >= 0 && f + direction < frame_count; f += direction) {
       std::vector<cv::Mat> next = load(f + direction);
-      propagate(f, f + direction, current, next);
+      const int to = f + direction;
+      const Positions shift = propagate(f, to, current, next);
+      if (shift.rows() > 0) {
+        SpreadBack(shift, anchor, to, &result.control);
+        anchor = to;
+      }
       current = std::move(next);
     }
   };

@@ -35,6 +35,12 @@
 
 namespace subflow::solver {
 
+// More than a quarter of the surface out of the correction's reach of its target
+// (MotionFrameReport::correction_unreached): the chain has lost the target there, e.g. a limb
+// left behind far from the reference frame. The retrack registers such frames
+// (ReconstructionOptions::retrack_register) and warns when they stay lost.
+constexpr double kLostTargetFraction = 0.25;
+
 struct MotionInitOptions {
   MotionStepOptions step;
   // Normal correction towards each frame's own fitted surface, when given: blend weight in
@@ -59,6 +65,16 @@ struct MotionInitOptions {
   // pass, whose targets are the refined shapes — one connectivity whose vertices already
   // follow the material — not for independent per-frame fits (shape initialization's).
   bool guess_from_targets = false;
+  // When a frame is registered, spread the registration's displacement back over the
+  // chain's frames since the previous registered frame (or the reference), in proportion
+  // to their distance from it: the surface that fell behind its targets over those frames
+  // catches up steadily instead of jumping at one frame.
+  bool spread_registration = false;
+  // Register a frame only when more than this fraction of its surface is out of the snap's
+  // reach of its target (correction_unreached before the registration: the chain lost part
+  // of the target, e.g. a swung limb), besides the registration's own distance gate;
+  // 0 = the distance gate alone.
+  double registration_min_unreached = 0.0;
   // Run the chains after and before the reference frame side by side (the same result as
   // one after the other).
   bool concurrent_chains = true;
@@ -78,6 +94,9 @@ struct MotionFrameReport {
   // nowhere within the correction's reach (first pass): surface that the correction cannot
   // bring back, e.g. a limb the chain left behind.
   double correction_unreached = 0.0;
+  // The same before the registration, when its gate measured it (registration_min_unreached
+  // > 0; else −1).
+  double unreached_before_registration = -1.0;
   SurfaceRegistrationReport registration;  // measured whenever corrected; `applied` when registered
 };
 
@@ -98,12 +117,14 @@ struct MotionInitResult {
 // the registration (`registration` built with options.registration, its gate deciding),
 // then the snap along the normals (hull_weight, |correction| ≤ max_correction,
 // hull_iterations). Fills report->corrected, correction_rms_before/applied and
-// registration. Returns the corrected finest control points.
+// registration; `registration_shift` (optional) receives the registration's displacement
+// of the finest control points (empty when not registered). Returns the corrected finest
+// control points.
 geometry::Positions CorrectTowardsFit(const geometry::LoopHierarchy& hierarchy,
                                       const SurfaceRegistration& registration,
                                       const geometry::Positions& control, const geometry::ClosestPointTree& fit,
                                       const MotionInitOptions& options, double max_correction,
-                                      MotionFrameReport* report);
+                                      MotionFrameReport* report, geometry::Positions* registration_shift = nullptr);
 
 // Trajectories for the frames of `images` (its gray images; frames and reference_frame
 // are window frames). `initial_control`: either one matrix (the reference frame's fitted

@@ -47,6 +47,15 @@ void SurfaceSnapOptions::Check() const {
     ThrowError("surface snapping", "iterations", "expected 1..100");
 }
 
+double UnreachedFraction(const geometry::LoopHierarchy& hierarchy, int level, const Positions& control,
+                         const geometry::ClosestPointTree& target, double max_distance) {
+  if (control.rows() == 0) return 0.0;
+  Positions normals;
+  int misses = 0;
+  NormalDistances(hierarchy, level, control, target, max_distance, &normals, &misses);
+  return static_cast<double>(misses) / static_cast<double>(control.rows());
+}
+
 Positions SnapToSurface(const geometry::LoopHierarchy& hierarchy, int level,
                         const Positions& control, const geometry::ClosestPointTree& target,
                         const SurfaceSnapOptions& options, SurfaceSnapReport* report) {

@@ -49,4 +49,10 @@ geometry::Positions SnapToSurface(const geometry::LoopHierarchy& hierarchy, int 
                                   const SurfaceSnapOptions& options,
                                   SurfaceSnapReport* report = nullptr);
 
+// Fraction of the limit points of `control` (level `level`) whose normal line meets `target`
+// nowhere within `max_distance`: surface that a snap along the normals cannot bring back
+// (SnapToSurface's first pass counts the same, as vertices_without_hit).
+double UnreachedFraction(const geometry::LoopHierarchy& hierarchy, int level, const geometry::Positions& control,
+                         const geometry::ClosestPointTree& target, double max_distance);
+
 }  // namespace subflow::solver

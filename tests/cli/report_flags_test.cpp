@@ -59,6 +59,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--no-retrack", {"", "/options/retrack", false}},
       {"--retrack-weight", {"0.3", "/options/retrack_weight", 0.3}},
       {"--retrack-highpass", {"1.3", "/options/retrack_highpass", 1.3}},
+      {"--no-retrack-register", {"", "/options/retrack_register", false}},
       {"--evidence", {"background", "/options/shape_init/silhouettes/source", "background"}},
       {"--levels", {"1", "/options/shape_init/levels", 1}},
       {"--base-faces", {"60", "/options/shape_init/simplify/target_face_count", 60}},

@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "core/error.h"
+#include "geometry/mean_edge_length.h"
+#include "geometry/multires_shape.h"
 #include "solver/reconstruction.h"
 #include "solver/rigid/rigid_motion.h"
 #include "solver/rigid/rigid_split.h"
@@ -299,6 +301,49 @@ TEST(MotionInit, FlagsADuplicatedFrameAndKeepsTheSurfaceStill) {
               1e3 * repeated);
   EXPECT_GT(moved, 0.5 * true_step);
   EXPECT_LT(repeated, 0.02 * true_step);
+}
+
+// A frame whose target has moved away (a limb the chain left behind: the images here stand
+// still, the target of the last frame is the surface shifted by 0.8 base edges) is
+// registered; with spread_registration, the displacement that the registration adds at that
+// frame is shared out over the frames since the reference in proportion to their distance
+// (1/3 and 2/3 of it), a steady motion instead of a jump. The registered frame itself is the
+// same either way.
+TEST(MotionInit, ARegistrationIsSpreadOverTheFramesSinceTheLastOne) {
+  const MotionTestScene& scene = Scene();
+  const std::vector<cv::Mat> still = testing::RenderGray(scene, scene.mesh.V);
+  const vision::ImageSequence images{scene.cameras, 0, 4, [&](int camera, int) { return still[camera].clone(); },
+                                     {}, {}};
+  const geometry::MultiresShape shape = geometry::MultiresShape::Analyze(scene.hierarchy, scene.control);
+  const double base_edge = geometry::MeanEdgeLength(scene.hierarchy.Topology(0), shape.base());
+  const Eigen::RowVector3d shift(0.8 * base_edge, 0.0, 0.0);
+  std::vector<Positions> targets(4, scene.control);
+  targets[3].rowwise() += shift;
+  MotionInitOptions options;
+  options.registration.enabled = true;
+  const MotionInitResult jump = InitializeMotion(images, scene.hierarchy, targets, 0, options);
+  options.spread_registration = true;
+  const MotionInitResult spread = InitializeMotion(images, scene.hierarchy, targets, 0, options);
+  ASSERT_TRUE(spread.frames[3].registration.applied);
+  for (int f = 1; f < 3; ++f) EXPECT_FALSE(spread.frames[f].registration.applied) << "frame " << f;
+  EXPECT_EQ((spread.control[3] - jump.control[3]).cwiseAbs().maxCoeff(), 0.0);
+
+  auto mean_step = [](const MotionInitResult& r, int f) {
+    return (r.control[f + 1] - r.control[f]).rowwise().norm().mean();
+  };
+  std::printf("mean step (mm), registration at frame 3 as a jump: %.3f %.3f %.3f; spread: %.3f %.3f %.3f\n",
+              1e3 * mean_step(jump, 0), 1e3 * mean_step(jump, 1), 1e3 * mean_step(jump, 2),
+              1e3 * mean_step(spread, 0), 1e3 * mean_step(spread, 1), 1e3 * mean_step(spread, 2));
+  // As a jump: the registered frame moves by most of the shift at once, the others hardly.
+  EXPECT_GT(mean_step(jump, 2), 0.5 * shift.norm());
+  EXPECT_LT(mean_step(jump, 0), 0.05 * shift.norm());
+  // Spread: the frames in between carry 1/3 and 2/3 of the same displacement, three equal steps.
+  const Positions third = spread.control[1] - jump.control[1];
+  EXPECT_LT((spread.control[2] - jump.control[2] - 2.0 * third).cwiseAbs().maxCoeff(), 1e-12);
+  for (int f = 0; f < 3; ++f) {
+    EXPECT_GT(mean_step(spread, f), 0.2 * shift.norm()) << "step " << f;
+    EXPECT_LT(mean_step(spread, f), 0.5 * shift.norm()) << "step " << f;
+  }
 }
 
 // A still (one frame) has no step: its trajectory is the reference control points, exactly,

@@ -202,6 +202,46 @@ TEST(SurfaceRegistration, MotionCorrectionBringsADriftedLimbBackOntoItsFit) {
   EXPECT_EQ((on - off).cwiseAbs().maxCoeff(), 0.0);
 }
 
+// The retrack's gate (registration_min_unreached): a frame is registered only when more than
+// that fraction of its surface is out of the snap's reach of its fit. The bent limb leaves
+// 0.29 of the straight limb's surface out of reach (next test): a quarter lets the
+// registration run as without the gate (the same result, to the bit), a half keeps it off
+// (the snap alone).
+TEST(SurfaceRegistration, ARegistrationGatedOnTheSurfaceOutOfReach) {
+  const BentLimb limb;
+  const geometry::ClosestPointTree fit(limb.bent, "bent limb");
+  MotionInitOptions options;
+  options.registration.enabled = true;
+  const SurfaceRegistration registration(limb.hierarchy, options.registration);
+  const auto correct = [&](double min_unreached, MotionFrameReport* report, Positions* shift) {
+    MotionInitOptions gated = options;
+    gated.registration_min_unreached = min_unreached;
+    return CorrectTowardsFit(limb.hierarchy, registration, limb.tracked, fit, gated, limb.max_correction, report,
+                             shift);
+  };
+  MotionFrameReport ungated_report, quarter_report, half_report;
+  Positions quarter_shift, half_shift;
+  const Positions ungated = correct(0.0, &ungated_report, nullptr);
+  const Positions quarter = correct(0.25, &quarter_report, &quarter_shift);
+  const Positions half = correct(0.5, &half_report, &half_shift);
+  EXPECT_TRUE(ungated_report.registration.applied);
+  EXPECT_TRUE(quarter_report.registration.applied);
+  EXPECT_EQ((quarter - ungated).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_FALSE(half_report.registration.applied);
+  // The registration's displacement is handed out when registered, and only then.
+  ASSERT_EQ(quarter_shift.rows(), limb.tracked.rows());
+  EXPECT_GT(quarter_shift.rowwise().norm().maxCoeff(), 0.1);  // the turned half moves (radius 1)
+  EXPECT_EQ(half_shift.rows(), 0);
+  options.registration.enabled = false;
+  MotionFrameReport snap_report;
+  const Positions snap_only =
+      CorrectTowardsFit(limb.hierarchy, registration, limb.tracked, fit, options, limb.max_correction, &snap_report);
+  EXPECT_EQ((half - snap_only).cwiseAbs().maxCoeff(), 0.0);
+
+  options.registration_min_unreached = 1.0;  // a fraction below 1
+  EXPECT_THROW(options.Check(), Error);
+}
+
 // What the correction could not reach is reported (MotionFrameReport::correction_unreached):
 // of the straight limb's surface against the limb bent 35° at its knee, the part beyond the
 // knee that turned away (0.29 of the surface) has no fit within the snap's reach; against
