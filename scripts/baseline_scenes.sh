@@ -21,7 +21,7 @@ mask_scene() {  # the dataset with the same images and masks
   case $1 in
     critter_nomasks) echo critter_ring ;;
     *_still_bare) echo "${1%_bare}" ;;
-    take_small|take_hd) echo "" ;;
+    take_small|take_fast|take_hd) echo "" ;;
     *) echo "$1" ;;
   esac
 }

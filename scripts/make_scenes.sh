@@ -60,6 +60,11 @@ scene pair_dark_still_bare pair --rig dome --cameras 10 --frames 1 --start-frame
 TAKE=(pair --rig ring --cameras 4 --distortion -0.12,0.03,0,0,0 --environment room --distractors both
       --video mp4 --no-masks --no-background)
 scene take_small   "${TAKE[@]}" --width 272 --height 480 --frames 24
+# Large motion far from the reference frame (the retrack's registration of lost frames:
+# docs/shape.md, "The retrack registers the frames that lost their refined surface"): the
+# take at 3x the motion per frame, and the pair's dome at 4x. Reconstruct all 24 frames.
+scene take_fast    "${TAKE[@]}" --width 272 --height 480 --frames 24 --motion 3
+scene pair_fast    pair    --rig dome --cameras 10 --environment room --frames 24 --motion 4
 # On request only (by name): the full-size take, and two long small takes for the memory
 # floor of issue 13 (a 1,000-frame take within 1.3x the memory of a 100-frame one).
 if [[ " ${ONLY[*]} " == *" take_hd "* ]]; then
