@@ -133,7 +133,7 @@ std::map<std::string, Case> Cases(const Inputs& in) {
       {"merge", {"merge " + motion + " --out " + Out("o_merge"), "o_merge/report.json", {{"--overwrite", ""}}}},
       {"plan", {"plan " + dataset + " --out " + Out("o_plan"), "o_plan/plan.json",
                 {{"--overwrite", ""}, {"--chunk", "2"}, {"--overlap", "1"}, {"--memory", "3000"}, {"--slurm", ""},
-                 {"--retrack-weight", "0.31"}, {"--retrack-highpass", "1.3"}, {"--hull-weight", "0.41"}, {"--no-refine", ""}, {"--no-retrack", ""},
+                 {"--retrack-weight", "0.31"}, {"--retrack-highpass", "1.3"}, {"--hull-weight", "0.41"}, {"--no-refine", ""}, {"--no-retrack", ""}, {"--no-retrack-register", ""},
                  {"--evidence", "background"}, {"--levels", "1"}, {"--base-faces", "60"}, {"--base-distance", "1.5"}, {"--finest-edge-pixels", "1.5"}, {"--max-finest-faces", "20000"}, {"--reference-frame", "1"},
                  {"--first-frame", "0"}, {"--frames", "3"}, {"--resolution", "28"}, {"--min-cameras", "3"},
                  {"--max-misses", "1"}, {"--evidence-threshold", "0.21"}, {"--footprint-margin", "1.7"},
