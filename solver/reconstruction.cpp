@@ -30,10 +30,10 @@ MotionInitOptions ReconstructionOptions::RetrackOptions() const {
   // pair_dome, 8 frames: 0.0576 → 0.0564, 0.1806 → 0.1799). A single pass at σ = 1 from that
   // start was measured too and is worse (0.0580): the coarse pass stays.
   retrack.guess_from_targets = true;
-  // The refined shapes share the trajectories' material points: nothing to register.
-  // A frame whose surface has lost its refined shape is registered to it, and the
-  // registration's displacement is spread over the frames since the last one registered
-  // (docs/shape.md, "The retrack on a take with large motion").
+  // A frame whose surface has lost its refined shape (more than kLostTargetFraction of it out
+  // of the snap's reach) is registered to it, and the registration's displacement is spread
+  // over the frames since the last one registered (docs/shape.md, "The retrack registers the
+  // frames that lost their refined surface").
   retrack.registration.enabled = retrack_register;
   retrack.registration_min_unreached = kLostTargetFraction;
   retrack.spread_registration = true;

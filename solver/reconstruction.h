@@ -60,7 +60,8 @@ struct ReconstructionOptions {
   // motion): observed accuracy P90 18.55 → 16.54 mm, completeness 0.228 → 0.237, EPE_rel
   // 0.555 → 0.577; take_small: 14.28 → 14.66 mm, EPE_rel 1.14 → 2.12 (its last frame's
   // refined surface is worse than the tracked one); the blob and the other scenes register
-  // nothing and are unchanged (docs/shape.md, "The retrack on a take with large motion").
+  // nothing and are unchanged (docs/shape.md, "The retrack registers the frames that lost
+  // their refined surface").
   bool retrack_register = true;
 
   void Check() const;  // throws subflow::Error naming the field
