@@ -36,12 +36,12 @@ nlohmann::json OptionsOf(const solver::ReconstructionOptions& options, Stage sta
 
 // Frames where a quarter of the refined surface stays out of the retrack's reach
 // (solver::kLostTargetFraction, after the retrack's registration): the chain has left the
-// refined shapes there (docs/shape.md, "The retrack on a take with large motion"). The motion
+// refined shapes there (docs/shape.md, "The retrack on a take with large motion" and "The
+// retrack registers the frames that lost their refined surface"). The motion
 // stage's targets, the per-frame hull fits, hold clutter on real takes (the shared pose2sim
 // take: over a quarter in 90 of 100 frames), so there the figure is only reported.
 void WarnRetrackOffTarget(const solver::MotionInitResult& figures, int first_frame) {
-  constexpr double kOffTargetFraction = solver::kLostTargetFraction;
-  const std::vector<int> off = figures.FramesOffTarget(kOffTargetFraction);
+  const std::vector<int> off = figures.FramesOffTarget(solver::kLostTargetFraction);
   if (off.empty()) return;
   double most = 0.0;
   for (const solver::MotionFrameReport& frame : figures.frames) most = std::max(most, frame.correction_unreached);
@@ -52,7 +52,7 @@ void WarnRetrackOffTarget(const solver::MotionInitResult& figures, int first_fra
       "frame's refined surface (up to {:.0f} %; report.json: retrack.frames[].correction_unreached): the tracked "
       "surface left it there, e.g. a limb far from the reference frame (the refine stage's own surfaces, with a "
       "poorer flow: `subflow split DATASET --from <refine stage folder> --out R`)",
-      off.size(), figures.frames.size(), frames, 100 * kOffTargetFraction, 100 * most);
+      off.size(), figures.frames.size(), frames, 100 * solver::kLostTargetFraction, 100 * most);
 }
 
 // Runs the solver stage and returns its state; *section gets its figures for the report.
