@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
+#include "core/peak_memory.h"
 #include "output/options_json.h"
 #include "output/result_files.h"
 #include "output/result_writer.h"
@@ -135,8 +136,9 @@ StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& 
   report["stage"] = StageName(stage);
   report["options"] = nlohmann::json::object();
   report["timings_seconds"] = nlohmann::json::object();
+  report["peak_memory_bytes"] = nlohmann::json::object();
   if (in) {  // what the stages before this one ran with and found
-    for (const char* key : {"options", "timings_seconds"})
+    for (const char* key : {"options", "timings_seconds", "peak_memory_bytes"})
       if (in->report.contains(key)) report[key] = in->report[key];
     for (Stage before : kStages)
       if (in->report.contains(StageSection(before))) report[StageSection(before)] = in->report[StageSection(before)];
@@ -146,6 +148,7 @@ StageRecord RunStage(Stage stage, const CommandRun& run, const vision::Dataset& 
   report["options"][StageSection(stage)] = OptionsOf(options, stage);
   report[StageSection(stage)] = section;
   report["timings_seconds"][StageSection(stage)] = seconds;
+  report["peak_memory_bytes"][StageSection(stage)] = PeakResidentBytes();
   if (store)
     FinishShapeStageFolder(folder, record, store->frames_fitted());
   else
@@ -172,6 +175,9 @@ void WriteReconstruction(const CommandRun& run, const vision::Dataset& dataset, 
   timings["total"] = since_start.Seconds();
   report["timings_seconds"] = timings;
   report["total_seconds"] = timings["total"];
+  nlohmann::json memory = last_report.value("peak_memory_bytes", nlohmann::json::object());
+  memory["writing"] = PeakResidentBytes();
+  report["peak_memory_bytes"] = memory;
   WriteJsonFile((fs::path(run.out) / "report.json").string(), report);
   spdlog::info("{}", split.BriefReport());
 }

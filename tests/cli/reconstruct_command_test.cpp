@@ -55,6 +55,15 @@ TEST(ReconstructCommand, WritesTheOutputLayoutWithFlowProperties) {
   EXPECT_EQ(report["command"], "reconstruct");
   for (const char* stage : {"shape_init", "motion_init", "refinement", "retrack", "total"})
     EXPECT_GT(report["timings_seconds"][stage].get<double>(), 0.0) << stage;
+  // The process's peak memory after each stage: it only rises, and no run of subflow (its
+  // libraries, the take's images) fits in 10 MB.
+  long long peak = 0;
+  for (const char* stage : {"shape_init", "motion_init", "refinement", "retrack", "writing"}) {
+    const long long after = report["peak_memory_bytes"][stage].get<long long>();
+    EXPECT_GE(after, peak) << stage;
+    peak = after;
+  }
+  EXPECT_GT(peak, 10'000'000);
   EXPECT_EQ(report["rigid_motion"].size(), 2u);
   // Each motion pass records the options it ran with: the second one its own hull weight
   // and high-pass (by default the first pass reads the intensities, the retrack the fine
