@@ -102,6 +102,10 @@ class MotionStepEstimator {
   // first pass linearizes at instead of zero (e.g. the step of trajectories known to be
   // close), so that fewer passes from coarse σ are needed; ignored when it matches the
   // images worse than zero motion (report.guess_used).
+  // Not copied: the solver refers to the samples' limit matrix.
+  MotionStepEstimator(const MotionStepEstimator&) = delete;
+  MotionStepEstimator& operator=(const MotionStepEstimator&) = delete;
+
   MotionStep Estimate(const geometry::Positions& control, const std::vector<cv::Mat>& before,
                       const std::vector<cv::Mat>& after, const geometry::Positions* guess = nullptr) const;
 

@@ -109,13 +109,13 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
     ThrowError("normal flow solver", "reference control points",
                std::to_string(reference_control.rows()) + " rows, expected " +
                    std::to_string(vertices));
-  limit_ = sample_limit;
-  limit_.makeCompressed();
+  if (!sample_limit.isCompressed())
+    ThrowError("normal flow solver", "sample limit matrix", "expected a compressed matrix (makeCompressed)");
+  limit_ = &sample_limit;
 
   // Prolongations P_i = C(n−1)⋯C(i), Laplacian Gram matrices, length scales.
   prolongation3_.resize(n_ + 1);
   level_limit_.resize(n_ + 1);
-  level_limit_transpose_.resize(n_ + 1);
   coarsening_.resize(n_ + 1);
   level_matrix_.resize(n_ + 1);
   smoothness3_.resize(n_ + 1);
@@ -137,20 +137,17 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   for (int level = n_; level >= lo_; --level) {
     if (level < n_) P = geometry::SparseMatrix(P * hierarchy.Refinement(level));
     if (level == hi_) {
-      stencils_ = MakeStencils(geometry::SparseMatrix(limit_ * P));
+      MakeStencils(geometry::SparseMatrix(sample_limit * P), &stencils_);
       data_pattern[level] = stencils_.pattern;
     } else if (level < hi_) {
       coarsening_[level] = CoarseningMap(data_pattern[level + 1], hierarchy.Refinement(level), &data_pattern[level]);
     }
     if (level <= hi_) {
-      if (level == hi_) {
-        level_limit_[level] = stencils_.limit;
-      } else {
-        level_limit_[level] = level_limit_[level + 1] * hierarchy.Refinement(level);
+      if (level < hi_) {  // level hi's is the stencils' own (LevelLimit)
+        level_limit_[level] = LevelLimit(level + 1) * hierarchy.Refinement(level);
         level_limit_[level].prune(1.0, kCancelledWeight);
         level_limit_[level].makeCompressed();
       }
-      level_limit_transpose_[level] = level_limit_[level].transpose();
       prolongation3_[level] = Kron3(P);
       const geometry::SparseMatrix U = geometry::UmbrellaLaplacian(hierarchy.Topology(level));
       smoothness3_[level] = Kron3(geometry::SparseMatrix(U.transpose() * U));
@@ -165,9 +162,8 @@ NormalFlowSolver::NormalFlowSolver(const geometry::LoopHierarchy& hierarchy,
   }
 }
 
-NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
-    const geometry::SparseMatrix& limit) {
-  SampleStencils stencils;
+void NormalFlowSolver::MakeStencils(const geometry::SparseMatrix& limit, SampleStencils* out) {
+  SampleStencils& stencils = *out;
   stencils.limit = limit.pruned(1.0, kCancelledWeight);
   stencils.limit.makeCompressed();
   const geometry::SparseMatrix& L = stencils.limit;
@@ -218,7 +214,6 @@ NormalFlowSolver::SampleStencils NormalFlowSolver::MakeStencils(
         E.valuePtr()[slot] = l[p] * l[q];
       }
   }
-  return stencils;
 }
 
 std::vector<double> NormalFlowSolver::DataSums(
@@ -233,8 +228,8 @@ std::vector<double> NormalFlowSolver::DataSums(
 }
 
 Positions NormalFlowSolver::SampleMotion(const Positions& displacement) const {
-  SUBFLOW_CHECK(displacement.rows() == limit_.cols(), "displacement of another level");
-  return RowParallelProduct<3>(limit_, displacement);
+  SUBFLOW_CHECK(displacement.rows() == limit_->cols(), "displacement of another level");
+  return RowParallelProduct<3>(*limit_, displacement);
 }
 
 std::vector<Positions> NormalFlowSolver::RigidPart(const Positions& control,
@@ -255,8 +250,8 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
                                    const std::vector<Positions>& rigid_part,
                                    double cg_tolerance, NormalFlowSolution* solution,
                                    Positions* sample_motion_out) const {
-  const int samples = static_cast<int>(limit_.rows());
-  const int vertices = static_cast<int>(limit_.cols());
+  const int samples = static_cast<int>(limit_->rows());
+  const int vertices = static_cast<int>(limit_->cols());
   // Per-sample aggregates: M_s = Σ w g gᵀ (6 unique entries), h_s = Σ w b g.
   Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> M =
       Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>::Zero(samples, 6);
@@ -301,7 +296,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
   for (int level = lo_; level <= hi_; ++level) {
     const int unknowns = 3 * hierarchy_->VertexCount(level);
     const Sparse& P3 = prolongation3_[level];
-    const geometry::SparseMatrix& level_limit = level_limit_[level];
+    const geometry::SparseMatrix& level_limit = LevelLimit(level);
     LevelSolveReport report;
     report.level = level;
     report.unknowns = unknowns;
@@ -328,7 +323,7 @@ void NormalFlowSolver::SolveLevels(const NormalFlowConstraints& constraints,
           sample_rhs(s, 2) = h(s, 2) - (m6[2] * u0 + m6[4] * u1 + m6[5] * u2);
         }
       });
-      const Positions data_rhs = RowParallelProduct<3>(level_limit_transpose_[level], sample_rhs);
+      const Positions data_rhs = TransposeParallelProduct<3>(level_limit, sample_rhs);
       const Eigen::VectorXd rhs = ConstVectorMap(data_rhs.data(), unknowns) -
                                   report.smoothness_weight * (smoothness3_[level] * W);
       // λ_i U_iᵀU_i + μ_i I = κ_i (smoothness (R/h_i)⁴ U_iᵀU_i + β_i I), precomputed.
@@ -378,11 +373,11 @@ std::unique_ptr<MultigridPreconditioner> NormalFlowSolver::MakeMultigrid(const B
 NormalFlowSolution NormalFlowSolver::Solve(const NormalFlowConstraints& constraints,
                                            const Positions& control,
                                            const NormalFlowSolution* warm_start) const {
-  const int samples = static_cast<int>(limit_.rows());
-  if (control.rows() != limit_.cols())
+  const int samples = static_cast<int>(limit_->rows());
+  if (control.rows() != limit_->cols())
     ThrowError("normal flow solver", "control points",
                std::to_string(control.rows()) + " rows, expected #V(n) = " +
-                   std::to_string(limit_.cols()));
+                   std::to_string(limit_->cols()));
   for (int c = 0; c < constraints.size(); ++c)
     if (constraints.sample[c] < 0 || constraints.sample[c] >= samples)
       ThrowError("normal flow solver", "constraint " + std::to_string(c),

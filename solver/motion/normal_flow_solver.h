@@ -140,7 +140,9 @@ struct NormalFlowSolution {
 
 class NormalFlowSolver {
  public:
-  // `sample_limit` is L (#S × #V(n), SurfaceSamples::limit of the finest level);
+  // `sample_limit` is L (#S × #V(n), SurfaceSamples::limit of the finest level, compressed);
+  // the solver keeps a reference to it and to `hierarchy`, which must outlive it (on an HD
+  // take L is hundreds of MB: MotionStepEstimator owns the one copy).
   // `reference_control` (#V(n)×3) fixes the length scales R and h_n. Precomputes the
   // prolongations, Laplacians and the sparsity pattern of Lᵀ L. Throws subflow::Error on
   // invalid options or sizes.
@@ -196,8 +198,10 @@ class NormalFlowSolver {
     // whose stencil holds both (row-major, samples ascending; lower entries' rows empty).
     geometry::SparseMatrix entry_weights;
   };
-  // Drops the rounding-noise entries of `limit` and builds the pair pattern.
-  static SampleStencils MakeStencils(const geometry::SparseMatrix& limit);
+  // Drops the rounding-noise entries of `limit` and builds the pair pattern, in `out`
+  // (filled in place: Eigen 3.4's SparseMatrix has no move assignment, and on an HD take
+  // a copy of these is hundreds of MB).
+  static void MakeStencils(const geometry::SparseMatrix& limit, SampleStencils* out);
   // The block sums (level_matrices.h) of L_hiᵀ M L_hi = P_hiᵀ (Lᵀ M L) P_hi for per-sample
   // symmetric 3×3 blocks M (#S×6: xx xy xz yy yz zz).
   static std::vector<double> DataSums(const SampleStencils& stencils,
@@ -206,10 +210,14 @@ class NormalFlowSolver {
   const geometry::LoopHierarchy* hierarchy_;
   NormalFlowSolverOptions options_;
   int n_ = 0, lo_ = 0, hi_ = 0;
-  geometry::SparseMatrix limit_;       // L, row-major
+  const geometry::SparseMatrix* limit_ = nullptr;  // L, row-major (the caller's)
   SampleStencils stencils_;            // of level hi
-  std::vector<geometry::SparseMatrix> level_limit_;  // L P_i (#S × #V(i)), by level lo..hi
-  std::vector<geometry::SparseMatrix> level_limit_transpose_;  // (L P_i)ᵀ, row-major
+  // L P_i (#S × #V(i)), by level lo..hi−1; level hi's is stencils_.limit. Their transposes
+  // are applied without being formed (TransposeParallelProduct).
+  std::vector<geometry::SparseMatrix> level_limit_;
+  const geometry::SparseMatrix& LevelLimit(int level) const {
+    return level == hi_ ? stencils_.limit : level_limit_[level];
+  }
   std::vector<geometry::SparseMatrix> coarsening_;  // block sums of level i+1 → i, by level lo..hi−1
   std::vector<LevelMatrix> level_matrix_;  // CG matrix structure, by level lo..hi
   std::vector<Sparse> prolongation3_;  // P_i ⊗ I3 (3#V(n) × 3#V(i)), by level
