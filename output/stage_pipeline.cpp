@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 #include "core/json_reader.h"
-#include "core/peak_memory.h"
+#include "core/memory.h"
 #include "output/options_json.h"
 #include "output/result_files.h"
 #include "output/result_writer.h"
@@ -235,6 +235,7 @@ nlohmann::json RunReconstruction(const CommandRun& run, const vision::Dataset& d
       last = RunStage(stage, run, dataset, options, in, folder, progress);
     }
     stages[StageName(stage)] = reuse ? "loaded" : "computed";
+    ReleaseFreeMemory();  // the stage's freed blocks: the next one allocates other sizes
   }
   WriteReconstruction(run, dataset, options, last->report, StateFrames(last->state), stages, since_start);
   return stages;
