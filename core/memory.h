@@ -22,7 +22,7 @@ inline long long PeakResidentBytes() {
 // elsewhere). Within a stage, `subflow` keeps freed blocks for the next step's arrays of
 // the same sizes (cli/main.cpp); between two stages of `reconstruct` they only fragment the
 // heap, and the next stage, allocating other sizes, grew the process beyond them: on Pose2Sim's
-// single-person take the retrack peaked at 3.0 GB alone and at 4.1 GB after the refinement
+// single-person take the retrack peaked at 3.1 GB alone and at 4.1 GB after the refinement
 // in one process (docs/speed.md, "Memory between stages").
 inline void ReleaseFreeMemory() {
 #if defined(__GLIBC__)
