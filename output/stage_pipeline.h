@@ -35,7 +35,8 @@ nlohmann::json StageOptionsJson(const solver::ReconstructionOptions& options, so
 // Runs `stage` on `in` (nullptr for the shape stage; the other stages need one), writes
 // its stage folder `folder` (which the caller prepared) and returns its record. The
 // report: the head of `run`, "stage", and, carried on from in's report and extended by
-// this stage, "options" (per stage section), each stage's figures and "timings_seconds".
+// this stage, "options" (per stage section), each stage's figures, "timings_seconds" and
+// "peak_memory_bytes" (docs/stages.md).
 // Without `keep_frames` (the stage commands, which read the record no further), the shape
 // stage writes each frame's hull and fit into the folder as it makes them
 // (ShapeStageFolderStore) and the record's state holds no frames: its memory does not

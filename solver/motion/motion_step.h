@@ -96,16 +96,15 @@ class MotionStepEstimator {
                       const std::vector<vision::Camera>& cameras,
                       const geometry::Positions& reference_control,
                       const MotionStepOptions& options = {});
+  // Not copied (nor moved): the solver refers to the samples' limit matrix.
+  MotionStepEstimator(const MotionStepEstimator&) = delete;
+  MotionStepEstimator& operator=(const MotionStepEstimator&) = delete;
 
   // Displacement of `control` (finest control points at the `before` frame) between the
   // two sets of images (one per camera). `guess` (optional, #V(n)×3): a displacement the
   // first pass linearizes at instead of zero (e.g. the step of trajectories known to be
   // close), so that fewer passes from coarse σ are needed; ignored when it matches the
   // images worse than zero motion (report.guess_used).
-  // Not copied: the solver refers to the samples' limit matrix.
-  MotionStepEstimator(const MotionStepEstimator&) = delete;
-  MotionStepEstimator& operator=(const MotionStepEstimator&) = delete;
-
   MotionStep Estimate(const geometry::Positions& control, const std::vector<cv::Mat>& before,
                       const std::vector<cv::Mat>& after, const geometry::Positions* guess = nullptr) const;
 

@@ -150,6 +150,11 @@ class NormalFlowSolver {
                    const geometry::SparseMatrix& sample_limit,
                    const geometry::Positions& reference_control,
                    const NormalFlowSolverOptions& options);
+  // Not from a temporary L or hierarchy: the solver would refer to them after they are gone.
+  NormalFlowSolver(const geometry::LoopHierarchy& hierarchy, geometry::SparseMatrix&& sample_limit,
+                   const geometry::Positions& reference_control, const NormalFlowSolverOptions& options) = delete;
+  NormalFlowSolver(geometry::LoopHierarchy&& hierarchy, const geometry::SparseMatrix& sample_limit,
+                   const geometry::Positions& reference_control, const NormalFlowSolverOptions& options) = delete;
 
   // Solves for the displacement of the finest control points `control` (#V(n)×3, the shape
   // the constraints' samples lie on). `warm_start` (optional): a previous solution for the

@@ -27,6 +27,7 @@ template <int Columns>
 RowMajorColumns<Columns> RowParallelProduct(const geometry::SparseMatrix& A,
                                             const Eigen::Ref<const RowMajorColumns<Columns>>& B) {
   SUBFLOW_CHECK(A.cols() == B.rows(), "product of mismatched sizes");
+  SUBFLOW_CHECK(A.isCompressed(), "product of an uncompressed matrix");
   RowMajorColumns<Columns> result(A.rows(), Columns);
   tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(A.rows()), 2048),
                     [&](const tbb::blocked_range<int>& range) {
@@ -49,6 +50,7 @@ template <int Columns>
 RowMajorColumns<Columns> TransposeParallelProduct(const geometry::SparseMatrix& A,
                                                   const Eigen::Ref<const RowMajorColumns<Columns>>& B) {
   SUBFLOW_CHECK(A.rows() == B.rows(), "product of mismatched sizes");
+  SUBFLOW_CHECK(A.isCompressed(), "product of an uncompressed matrix");
   constexpr int kRowsPerChunk = 32768, kMaxChunks = 16;
   const int rows = static_cast<int>(A.rows());
   const int chunks = std::clamp(rows / kRowsPerChunk, 1, kMaxChunks);

@@ -56,7 +56,7 @@ TEST(RowProduct, ProductsAgreeWithEigensAndDoNotDependOnTheThreads) {
   EXPECT_EQ(single_transposed, transposed);
 }
 
-TEST(RowProduct, TheTransposedProductOfAShortMatrixIsOneChunk) {
+TEST(RowProduct, TheTransposedProductOfAShortMatrixMatchesEigens) {
   const Operands o = MakeOperands(10, 4);
   const RowMajorColumns<3> transposed = TransposeParallelProduct<3>(o.A, o.B_rows);
   const RowMajorColumns<3> eigen_transposed = o.A.transpose() * o.B_rows;
