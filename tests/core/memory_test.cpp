@@ -42,11 +42,7 @@ TEST(Memory, FreedHeapBlocksAreGivenBackAndThePeakRemembersThem) {
                   "so neither mallopt nor malloc_trim applies";
 #endif
   if (ResidentBytes() < 0) GTEST_SKIP() << "no /proc/self/statm to read the resident size from";
-#if defined(__GLIBC__)
-  // As cli/main.cpp sets them: freed blocks up to 256 MB stay in the heap.
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 512 << 20);
-#endif
+  KeepFreedMemoryForReuse();  // as subflow's main sets it: freed blocks up to 256 MB stay
   constexpr std::size_t kBlock = 4 << 20, kBlocks = 64;  // 256 MB in blocks of 4 MB
   std::vector<std::unique_ptr<char[]>> blocks;
   for (std::size_t b = 0; b < kBlocks; ++b) {
