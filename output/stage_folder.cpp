@@ -4,6 +4,9 @@
 #include <filesystem>
 #include <functional>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/file_status.h"
 #include "core/json_reader.h"
@@ -53,6 +56,53 @@ void WriteFittedSurfaces(const std::string& folder, const geometry::LoopHierarch
   }
 }
 
+// outlines/<camera index>.png, per camera with an outline (StageState::outlines), and the
+// list of their paths relative to the folder ("" for a camera without one); empty when
+// the state has none.
+nlohmann::json WriteOutlineFiles(const std::string& folder, const std::vector<cv::Mat>& outlines) {
+  nlohmann::json paths = nlohmann::json::array();
+  if (outlines.empty()) return paths;
+  std::error_code error;
+  fs::create_directories(fs::path(folder) / "outlines", error);
+  if (error) ThrowError(folder + "/outlines", "", "cannot create the directory: " + error.message());
+  for (std::size_t k = 0; k < outlines.size(); ++k) {
+    if (outlines[k].empty()) {
+      paths.push_back("");
+      continue;
+    }
+    const std::string name = "outlines/" + std::to_string(k) + ".png";
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", outlines[k], png)) ThrowError(folder + "/" + name, "", "cannot encode the outline");
+    AtomicFile file((fs::path(folder) / name).string());
+    file.stream().write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+    file.Commit();
+    paths.push_back(name);
+  }
+  return paths;
+}
+
+// The outlines report.json's "outlines" lists (absent: none), read from their files.
+std::vector<cv::Mat> ReadOutlineFiles(const std::string& folder, const nlohmann::json& report,
+                                      const JsonReader& reader) {
+  std::vector<cv::Mat> outlines;
+  if (!report.contains("outlines")) return outlines;
+  const nlohmann::json& paths = report["outlines"];
+  if (!paths.is_array()) reader.Fail("outlines", "expected an array of file names");
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    const std::string field = "outlines[" + std::to_string(k) + "]";
+    const std::string name = reader.String(paths[k], field);
+    if (name.empty()) {
+      outlines.emplace_back();
+      continue;
+    }
+    const fs::path path = fs::path(folder) / name;
+    cv::Mat outline = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+    if (outline.empty()) ThrowError(path.string(), "", "missing or unreadable (expected the " + field + " PNG)");
+    outlines.push_back(outline);
+  }
+  return outlines;
+}
+
 // Creates `folder` and removes its report.json: unfinished until WriteStageReport.
 void BeginStageFolder(const std::string& folder) {
   std::error_code error;
@@ -74,6 +124,11 @@ void WriteStageReport(const std::string& folder, const StageRecord& record, int 
   report["levels"] = state.Hierarchy().finest_level();
   report["evidence"] = vision::ToString(state.evidence);
   report["image_scales"] = state.image_scales;
+  const nlohmann::json outlines = WriteOutlineFiles(folder, state.outlines);
+  if (outlines.empty())
+    report.erase("outlines");
+  else
+    report["outlines"] = outlines;
   WriteJsonFile(ReportPath(folder), report);
 }
 
@@ -168,6 +223,7 @@ StageRecord ReadStageFolderHead(const std::string& folder, const std::string& ex
   for (std::size_t k = 0; k < state.image_scales.size(); ++k)
     if (!(state.image_scales[k] > 0 && state.image_scales[k] <= 1))
       reader.Fail("image_scales[" + std::to_string(k) + "]", "expected a scale in (0, 1]");
+  state.outlines = ReadOutlineFiles(folder, report, reader);
   const fs::path root(folder);
   state.base_mesh = ReadStageMesh(root / "base_mesh.ply");
   state.hierarchy = std::make_shared<const geometry::LoopHierarchy>(

@@ -6,6 +6,10 @@
 //   <folder>/control/<frame>/level_<i>.ply  the frame's control points: every level for the
 //                                           shape stage, the finest level for the others
 //   <folder>/meshes/<frame>.ply             (shape stage) the fitted limit surfaces, OUTPUT.md
+//   <folder>/outlines/<camera>.png          per camera index, the object's outline when the
+//                                           shape stage measured one (StageState::outlines:
+//                                           a still set on a plain backdrop); listed in
+//                                           report.json's "outlines" 
 //   <folder>/report.json                    written last: stage_layout_version, stage,
 //                                           frames, reference_frame, levels, evidence, the
 //                                           options and figures of every stage so far

@@ -96,6 +96,8 @@ nlohmann::json MergeStageFolders(const CommandRun& run, const std::vector<std::s
   const fs::path out(folder);
   fs::remove(out / "report.json");
   CopyFinished(fs::path(parts.front().folder) / "base_mesh.ply", out / "base_mesh.ply");
+  if (fs::exists(fs::path(parts.front().folder) / "outlines"))  // the report's "outlines" lists them
+    CopyFinished(fs::path(parts.front().folder) / "outlines", out / "outlines");
   for (int frame = first; frame < end; ++frame) {
     const fs::path source(parts[sources[frame - first]].folder);
     const std::string name = vision::FrameName(frame);

@@ -94,6 +94,12 @@ struct StageState {
   // stored size; empty = every camera at 1): chosen once by the shape stage from the
   // reference frame's fitted surface (ShapeInitOptions::image_edge_pixels).
   std::vector<double> image_scales;
+  // Per camera, the object's outline the shape stage measured for every frame, which the
+  // motion and refinement stages take as that camera's mask (CV_8UC1, 0 / 255, raw image
+  // coordinates, any scale of the camera's images); empty = none (masks from the dataset,
+  // else the projected hulls). A still set against a plain backdrop has them
+  // (ShapeInitResult::outlines).
+  std::vector<cv::Mat> outlines;
 
   int frame_count() const { return static_cast<int>(control.size()); }
   int reference_index() const { return reference_frame - first_frame; }
@@ -106,7 +112,8 @@ struct StageState {
 };
 
 // Images of the state's frames as the motion and refinement stages read them (gray images
-// and silhouettes: masks where the evidence is masks, else the projected hulls). `dataset`
+// and silhouettes: masks where the evidence is masks, else the state's outlines, else the
+// projected hulls). `dataset`
 // and `state` must outlive the sequence.
 vision::ImageSequence StageImages(const vision::Dataset& dataset, const StageState& state);
 

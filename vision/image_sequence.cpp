@@ -21,7 +21,7 @@ cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolatio
 
 ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,
                             EvidenceSource evidence, const std::vector<geometry::TriangleMesh>* hulls,
-                            const std::vector<Camera>* working) {
+                            const std::vector<Camera>* working, const std::vector<cv::Mat>* outlines) {
   if (first_frame < 0 || frame_count < 1 || first_frame + frame_count > dataset.frame_count())
     ThrowError(dataset.directory(), "frames",
                "window [" + std::to_string(first_frame) + ", " + std::to_string(first_frame + frame_count) +
@@ -31,6 +31,11 @@ ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_c
                std::to_string(hulls->size()) + " visual hulls for " + std::to_string(frame_count) + " frames");
   SUBFLOW_CHECK(!working || static_cast<int>(working->size()) == dataset.camera_count(),
                 "one working camera per camera of the dataset");
+  if (outlines && outlines->empty()) outlines = nullptr;
+  if (outlines && static_cast<int>(outlines->size()) != dataset.camera_count())
+    ThrowError(dataset.directory(), "outlines",
+               std::to_string(outlines->size()) + " outlines for " + std::to_string(dataset.camera_count()) +
+                   " cameras");
   ImageSequence sequence;
   sequence.cameras = working ? *working : dataset.cameras();
   sequence.first_frame = first_frame;
@@ -42,14 +47,19 @@ ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_c
                        cv::INTER_LINEAR);
   };
   std::vector<bool> masks(dataset.camera_count());
-  for (int k = 0; k < dataset.camera_count(); ++k)
+  sequence.tight_outline.resize(dataset.camera_count());
+  for (int k = 0; k < dataset.camera_count(); ++k) {
     masks[k] = (evidence == EvidenceSource::kAuto ? AutomaticSource(dataset, k) : evidence) == EvidenceSource::kMask;
-  sequence.tight_outline.assign(masks.begin(), masks.end());
-  sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras](int camera, int frame) {
+    sequence.tight_outline[k] = masks[k] || (outlines && !(*outlines)[k].empty());
+  }
+  sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras, outlines](int camera, int frame) {
     const Camera& working_camera = cameras[camera];
     if (masks[camera])
       return Undistorted(working_camera,
                          ResizeToCamera(dataset.Mask(camera, first_frame + frame), working_camera, true),
+                         cv::INTER_NEAREST);
+    if (outlines && !(*outlines)[camera].empty())
+      return Undistorted(working_camera, ResizeToCamera((*outlines)[camera], working_camera, true),
                          cv::INTER_NEAREST);
     if (!hulls || (*hulls)[frame].F.rows() == 0) return cv::Mat();
     const geometry::TriangleMesh& hull = (*hulls)[frame];

@@ -53,10 +53,14 @@ cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolatio
 // coordinates) rendered into the camera (ZBuffer::Mask), none when `hulls` is null or that
 // hull is empty; tight_outline says which. `working`: per camera, the working camera (vision/working_scale.h) whose
 // size every image is resized to before undistortion, and which the sequence's cameras
-// are; null = the stored cameras and sizes.
+// are; null = the stored cameras and sizes. `outlines` (may be null or empty; else one per
+// camera, which must outlive the sequence): a camera without a mask whose outline is not
+// empty takes it as its mask in every frame (CV_8UC1 in raw image coordinates, resized to
+// the working size at half coverage), a tight outline.
 ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,
                             EvidenceSource evidence = EvidenceSource::kAuto,
                             const std::vector<geometry::TriangleMesh>* hulls = nullptr,
-                            const std::vector<Camera>* working = nullptr);
+                            const std::vector<Camera>* working = nullptr,
+                            const std::vector<cv::Mat>* outlines = nullptr);
 
 }  // namespace subflow::vision

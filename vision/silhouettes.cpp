@@ -128,6 +128,8 @@ void SilhouetteOptions::Check() const {
              "an integer in [0, 100] pixels", background_open_radius);
   CheckRange(close_radius >= 0 && close_radius <= 100, "close_radius",
              "an integer in [0, 100] pixels", close_radius);
+  CheckRange(background_close_floor >= 0 && background_close_floor <= 1, "background_close_floor",
+             "a fraction in [0, 1]", background_close_floor);
   CheckRange(min_region_pixels >= 0, "min_region_pixels", "a non-negative integer",
              min_region_pixels);
   CheckRange(min_object_pixels >= 1, "min_object_pixels", "a positive integer",
@@ -235,14 +237,19 @@ void SetMask(const cv::Mat& mask, const SilhouetteOptions& options, Silhouette* 
 }  // namespace
 
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options, int open_radius) {
+                             const SilhouetteOptions& options, int open_radius, double close_floor) {
   SUBFLOW_CHECK(measure.type() == CV_32FC1, "ThresholdAndClean expects CV_32FC1");
   Silhouette silhouette;
   silhouette.measure = measure;
   silhouette.threshold = threshold;
   cv::Mat mask = measure > threshold;  // CV_8U 0 / 255
   if (open_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_OPEN, Disk(open_radius));
-  if (options.close_radius > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, Disk(options.close_radius));
+  if (options.close_radius > 0) {
+    cv::Mat closed;
+    cv::morphologyEx(mask, closed, cv::MORPH_CLOSE, Disk(options.close_radius));
+    if (close_floor > 0) closed &= mask | (measure >= close_floor);
+    mask = closed;
+  }
   if (options.min_region_pixels > 1) RemoveSmallRegions(&mask, options.min_region_pixels);
   if (options.fill_holes) FillHoles(&mask);
   SetMask(mask, options, &silhouette);
@@ -333,7 +340,8 @@ Silhouette SilhouetteFromDifference(const cv::Mat& image, const cv::Mat& backgro
                                                       : plain;
   if (!unknown.empty()) difference.setTo(1.0f, unknown);
   const cv::Mat measure = Smooth(difference, options.background_blur_sigma);
-  Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius);
+  Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius,
+                                            options.background_close_floor * threshold);
   silhouette.source = EvidenceSource::kBackground;
   if (options.background_contour_fraction > 0)
     SetMask(HalfContrastContour(measure, silhouette.mask, options.background_contour_fraction), options,

@@ -180,6 +180,15 @@ struct SilhouetteOptions {
   // moving texture and contour fragments into one region, closes bites of weak evidence
   // at the contour). Also closes real concavities narrower than 2r + 1 pixels. 0 = none.
   int close_radius = 5;
+  // The closing of background-difference silhouettes adds only pixels whose difference
+  // reaches this fraction of the threshold. What the closing is for — parts of the object
+  // that differ from the background a little, below the threshold, between parts that
+  // differ more — stays joined; the background seen between two legs, or between an arm
+  // and the body, differs not at all and stays open (a plain closing filled such gaps
+  // narrower than 2r + 1 pixels: webs the hull then kept; docs/shape.md, "Gaps between
+  // limbs"). Not applied to motion evidence, whose closing fills the flat, untextured
+  // inside of the object, where θ is 0. 0 = a plain closing.
+  double background_close_floor = 0.5;
   // Fill holes of the silhouette (background regions not connected to the image border).
   // Right for objects without through-holes; turn off for a torus seen through its hole.
   bool fill_holes = true;
@@ -208,6 +217,12 @@ struct Silhouette {
   double threshold = 0.5;
   int object_pixels = 0;  // non-zero pixels of `mask`
   bool empty = true;      // object_pixels < options.min_object_pixels
+  // A measured silhouette that is the object's own outline, as a mask is: the difference to
+  // a plain backdrop (solver/shape/shape_init.cpp, BackdropSilhouettes), where whatever
+  // differs from the backdrop is the object. Carved without the hull's cleaning, and the
+  // refinement pulls the surface's rim onto it, as for masks (docs/shape.md, "Gaps between
+  // limbs, and a backdrop's silhouettes as outlines"). Masks are outlines whatever this says.
+  bool outline = false;
 };
 
 // Otsu's threshold of a CV_32FC1 image: the value t maximizing the between-class
@@ -289,8 +304,9 @@ Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const Estimat
 // of radius open_radius, closing of radius options.close_radius (disks), regions under
 // options.min_region_pixels removed, holes filled (options.fill_holes); fills every
 // field of the returned Silhouette except `source`.
+// With close_floor > 0, the closing adds only pixels whose measure is ≥ close_floor.
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options, int open_radius = 0);
+                             const SilhouetteOptions& options, int open_radius = 0, double close_floor = 0);
 
 // The evidence camera `camera` of `dataset` takes for EvidenceSource::kAuto: masks if the
 // dataset has them, else the background image if background/<camera>.png exists, else

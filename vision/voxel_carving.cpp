@@ -147,17 +147,19 @@ void Warn(CarvingResult* result, const std::string& message, spdlog::level::leve
 }
 
 // The automatic values, by the used cameras' evidence: max_misses 1 when some silhouette
-// comes from motion, else 0; closing and opening radii 0 when every one is a mask, else 1.
+// comes from motion, else 0; closing and opening radii 0 when every one is the object's
+// outline (a mask, or Silhouette::outline), else 1.
 void ResolveBySources(const std::vector<CarvingCamera>& used, const std::vector<Silhouette>& silhouettes,
                       const VoxelCarvingOptions& options, CarvingResult* result) {
-  bool any_motion = false, all_masks = true;
+  bool any_motion = false, all_outlines = true;
   for (const CarvingCamera& c : used) {
-    any_motion = any_motion || silhouettes[c.index].source == EvidenceSource::kMotion;
-    all_masks = all_masks && silhouettes[c.index].source == EvidenceSource::kMask;
+    const Silhouette& silhouette = silhouettes[c.index];
+    any_motion = any_motion || silhouette.source == EvidenceSource::kMotion;
+    all_outlines = all_outlines && (silhouette.source == EvidenceSource::kMask || silhouette.outline);
   }
   result->max_misses = options.max_misses >= 0 ? options.max_misses : (any_motion ? 1 : 0);
-  result->closing_radius = options.closing_radius >= 0 ? options.closing_radius : (all_masks ? 0 : 1);
-  result->opening_radius = options.opening_radius >= 0 ? options.opening_radius : (all_masks ? 0 : 1);
+  result->closing_radius = options.closing_radius >= 0 ? options.closing_radius : (all_outlines ? 0 : 1);
+  result->opening_radius = options.opening_radius >= 0 ? options.opening_radius : (all_outlines ? 0 : 1);
 }
 
 }  // namespace

@@ -99,7 +99,8 @@ struct VoxelCarvingOptions {
   double footprint_margin = 0.5;
   // Radius (voxels) of the closing, then of the opening (box (2r + 1)³); 0 = skip. These
   // are the radii on the automatic grid; ResolveCarvingOptions narrows them on a coarser one.
-  // −1 = automatic: 0 when every used camera's evidence is a mask, 1 otherwise. The
+  // −1 = automatic: 0 when every used camera's evidence is the object's outline (a mask, or
+  // a plain backdrop's difference: Silhouette::outline), 1 otherwise. The
   // cleaning is for measured silhouettes (background differences, motion, stills: specks,
   // bites); on masks it only removes thin parts (a 3 mm ear plate on 2.8 mm voxels) and
   // bridges narrow gaps (between legs), and without it the refined surfaces of the mask

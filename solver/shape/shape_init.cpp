@@ -227,6 +227,9 @@ std::vector<vision::Silhouette> StandingSilhouettes(const std::vector<vision::Es
 //    backdrop fits a shadow's gain as well as a shadow does, and was carved away (a
 //    sphere's shaded side); a shadow cast on the backdrop now stays in the silhouette,
 //    which only makes the hull larger.
+// Against a plain backdrop whatever differs is the object, so each silhouette is its
+// outline (Silhouette::outline, result->outlines): the hull is carved as from masks, and
+// the refinement draws the surface's rim onto it.
 // Empty when some camera's backdrop is not plain, or when some camera's silhouette is empty
 // (result->backdrops has every camera's figures either way).
 std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& dataset, int reference,
@@ -257,6 +260,7 @@ std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& datas
     silhouettes[k] = vision::SilhouetteFromBackground(
         images[k], vision::BackdropImage(images[k], result->backdrops[k]), plain_options);
     silhouettes[k].source = vision::EvidenceSource::kStill;
+    silhouettes[k].outline = true;
   });
   result->backdrop_seconds = start.Seconds();
   const auto empty = std::find_if(silhouettes.begin(), silhouettes.end(), [](const auto& s) { return s.empty; });
@@ -266,6 +270,8 @@ std::vector<vision::Silhouette> BackdropSilhouettes(const vision::Dataset& datas
     return {};
   }
   result->used_backdrop = true;
+  result->outlines.resize(silhouettes.size());
+  for (std::size_t k = 0; k < silhouettes.size(); ++k) result->outlines[k] = silhouettes[k].mask;
   spdlog::info("no masks, no background and nothing moves: frame {} against a plain backdrop in every camera "
                "(widest spread {:.3f})",
                reference, widest->spread);

@@ -156,6 +156,10 @@ struct ShapeInitResult {
   bool used_still = false;
   bool used_backdrop = false;
   std::vector<vision::PlainBackdrop> backdrops;
+  // With used_backdrop, per camera: the backdrop silhouette (CV_8UC1, 0 / 255, at the
+  // evidence's scale, raw image coordinates): the object's outline in every frame, which
+  // the refinement takes as a mask (StageState::outlines).
+  std::vector<cv::Mat> outlines;
   double backdrop_seconds = 0;  // measuring the backdrops and their silhouettes
   vision::StillEvidence still;
   // Per camera, the scale of the images the evidence was computed on (1 = stored size;

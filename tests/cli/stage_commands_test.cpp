@@ -9,8 +9,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
 #include "geometry/mesh_io.h"
+#include "output/stage_folder.h"
 #include "tests/test_support.h"
+#include "vision/dataset.h"
+#include "vision/image_sequence.h"
+#include "vision/working_scale.h"
 
 namespace subflow {
 namespace {
@@ -199,6 +204,43 @@ TEST(StageCommands, RefinementRangesMergeIntoOneStageFolder) {
       "merge " + Quoted(work / "a") + " " + Quoted(work / "c") + " --out " + Quoted(work / "gap"), Scratch().path());
   EXPECT_EQ(gap.exit_code, 1);
   EXPECT_NE(gap.err.find("frame 4"), std::string::npos) << gap.output();
+}
+
+// A still set against a plain backdrop: the shape stage's silhouettes are the object's
+// outlines, written to the stage folder (outlines/<camera>.png, listed in report.json), read
+// back with it, and the later stages take them as the cameras' masks: tight outlines, the
+// same pixels. A missing outline file is refused, naming it.
+TEST(StageCommands, AStillOnAPlainBackdropHandsItsOutlinesToTheLaterStages) {
+  const fs::path work = Scratch().Subdirectory("outlines");
+  const fs::path dataset = work / "still";
+  RunOk("synth sphere --out " + Quoted(dataset) +
+        " --cameras 6 --frames 1 --width 160 --height 120 --no-masks --no-background");
+  RunOk("shape " + Quoted(dataset) + " --out " + Quoted(work / "shape") + kShape);
+  const nlohmann::json report = ReadReport(work / "shape");
+  ASSERT_EQ(report["outlines"].size(), 6u) << report["outlines"];
+  EXPECT_EQ(report["outlines"][0], "outlines/0.png");
+
+  const vision::Dataset opened(dataset.string());
+  const output::StageRecord record = output::ReadStageFolder((work / "shape").string(), "shape");
+  ASSERT_EQ(record.state.outlines.size(), 6u);
+  const vision::ImageSequence images = solver::StageImages(opened, record.state);
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(images.tight_outline.at(k), 1) << "camera " << k;
+    const cv::Mat silhouette = images.silhouette(k, 0);  // at the stages' working image scale
+    const cv::Mat outline = vision::ResizeToCamera(record.state.outlines[k], images.cameras[k], true);
+    ASSERT_EQ(silhouette.size(), outline.size());
+    EXPECT_GT(cv::countNonZero(outline), 300) << "camera " << k;
+    EXPECT_EQ(cv::countNonZero(silhouette != outline), 0) << "camera " << k;
+  }
+
+  fs::remove(work / "shape" / "outlines" / "3.png");
+  try {
+    output::ReadStageFolder((work / "shape").string(), "shape");
+    FAIL() << "a stage folder without its outline file was read";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("3.png"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("outlines[3]"), std::string::npos) << error.what();
+  }
 }
 
 TEST(StageCommands, AnUnfinishedOrWrongStageFolderIsRefused) {

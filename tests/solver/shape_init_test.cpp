@@ -408,6 +408,19 @@ TEST(ShapeInit, StillSetOnAPlainBackdropIsCarvedFromTheBackdropsColour) {
   const FrameShapeInit& frame = result.frames.at(0);
   EXPECT_EQ(frame.carving.cameras.front().source, vision::EvidenceSource::kStill);
   ExpectAsCloseAsTheMaskHull(dataset, frame, with_masks, from_masks.frames[0], "plain backdrop");
+  // Against a plain backdrop the silhouettes are the object's outlines: carved as masks
+  // are (no cleaning of the hull), and handed on for the refinement to take as masks.
+  EXPECT_EQ(frame.carving.closing_radius, 0);
+  EXPECT_EQ(frame.carving.opening_radius, 0);
+  ASSERT_EQ(result.outlines.size(), 10u);
+  for (int k = 0; k < 10; ++k) {
+    const cv::Mat& outline = result.outlines[k];
+    ASSERT_EQ(outline.type(), CV_8UC1);
+    const cv::Mat truth = with_masks.Mask(k, 0);
+    ASSERT_EQ(outline.size(), truth.size());
+    EXPECT_GT(vision::SilhouetteIoU(outline, truth), 0.95) << "camera " << k;
+  }
+  EXPECT_TRUE(from_masks.outlines.empty());
 }
 
 // A still set that neither the backdrop (here turned off: the synthetic backdrop is plain)

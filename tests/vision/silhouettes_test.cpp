@@ -196,6 +196,38 @@ TEST(Silhouettes, MotionEvidenceIsPositiveWhereTextureMovesAndZeroElsewhere) {
   EXPECT_THROW(MotionEvidence({still}, 0, options), Error);  // one frame has no ∂I/∂t
 }
 
+// Two legs (bars of 0.6 on a backdrop of 0.1), 5 px apart — the backdrop shows between
+// them — and across the left leg a band 3 px high of a colour close to the backdrop's
+// (difference 0.04, below the threshold of 0.06 and above half of it: a dark part of the
+// object). The closing joins the leg across the dark band, and leaves the gap between the
+// legs open: it adds only pixels that differ from the backdrop by half the threshold. A
+// plain closing (background_close_floor 0) fills the gap, a web between the legs.
+TEST(Silhouettes, BackgroundClosingJoinsDarkPartsButNotTheGapsBetweenLimbs) {
+  const int width = 80, height = 80;
+  cv::Mat image(height, width, CV_32F, cv::Scalar(0.1f));
+  const cv::Rect left(20, 10, 12, 60), right(37, 10, 12, 60), band(20, 38, 12, 3);
+  image(left).setTo(0.6f);
+  image(right).setTo(0.6f);
+  image(band).setTo(0.14f);
+  cv::Mat image8, background8;
+  image.convertTo(image8, CV_8U, 255.0);
+  cv::Mat(cv::Mat::ones(height, width, CV_32F) * 0.1f).convertTo(background8, CV_8U, 255.0);
+
+  SilhouetteOptions options;
+  options.background_threshold = 0.06;
+  options.background_shadow_test = false;
+  const Silhouette silhouette = SilhouetteFromBackground(image8, background8, options);
+  const cv::Mat gap = silhouette.mask(cv::Rect(33, 12, 3, 56));
+  const cv::Mat joined = silhouette.mask(cv::Rect(23, 38, 6, 3));
+  EXPECT_EQ(cv::countNonZero(gap), 0) << "the backdrop between the legs became object";
+  EXPECT_EQ(cv::countNonZero(joined), joined.rows * joined.cols) << "the dark band was not joined";
+
+  options.background_close_floor = 0;
+  const Silhouette plain = SilhouetteFromBackground(image8, background8, options);
+  EXPECT_GT(cv::countNonZero(plain.mask(cv::Rect(33, 12, 3, 56))), 100);  // the web a plain closing makes
+  EXPECT_EQ(cv::countNonZero(plain.mask(cv::Rect(23, 38, 6, 3))), 18);
+}
+
 TEST(Silhouettes, OptionsAreChecked) {
   SilhouetteOptions options;
   EXPECT_NO_THROW(options.Check());
