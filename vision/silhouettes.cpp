@@ -477,9 +477,13 @@ Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const Estimat
   // subject are less certain than a photographed background, and on the synthetic take
   // take_small (scripts/make_scenes.sh) the noise threshold and the shadow test emptied
   // the hull. Here the plain difference and the histogram threshold, as before, until a
-  // rule holds for both.
+  // rule holds for both. For the same reason the plain closing: the subject's parts
+  // differ from such a background by little, and with background_close_floor the closing
+  // no longer joined them — on pose2sim_multiperson the man's standing shin and foot fell
+  // out of frame 50's hull in two cameras (docs/shape.md, "Gaps between limbs").
   SilhouetteOptions plain = options;
   plain.background_shadow_test = false;
+  plain.background_close_floor = 0;
   return SilhouetteFromDifference(ToUnitFloat(image), background.image, background.known == 0, cv::Mat(), plain);
 }
 

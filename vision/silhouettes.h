@@ -178,7 +178,8 @@ struct SilhouetteOptions {
   // --- cleaning of thresholded background / motion evidence (not of given masks) ---
   // Radius (pixels) of the 2D morphological closing of the thresholded image (joins
   // moving texture and contour fragments into one region, closes bites of weak evidence
-  // at the contour). Also closes real concavities narrower than 2r + 1 pixels. 0 = none.
+  // at the contour). A plain closing also fills real gaps narrower than 2r + 1 pixels
+  // (between legs); background_close_floor keeps those open. 0 = none.
   int close_radius = 5;
   // The closing of background-difference silhouettes adds only pixels whose difference
   // reaches this fraction of the threshold. What the closing is for — parts of the object
@@ -186,8 +187,10 @@ struct SilhouetteOptions {
   // differ more — stays joined; the background seen between two legs, or between an arm
   // and the body, differs not at all and stays open (a plain closing filled such gaps
   // narrower than 2r + 1 pixels: webs the hull then kept; docs/shape.md, "Gaps between
-  // limbs"). Not applied to motion evidence, whose closing fills the flat, untextured
-  // inside of the object, where θ is 0. 0 = a plain closing.
+  // limbs"). For a background image and a plain backdrop; not for a background estimated
+  // from the video (whose differences on the subject are weak: SilhouetteFromEstimatedBackground),
+  // nor for motion evidence, whose closing fills the flat, untextured inside of the object,
+  // where θ is 0. 0 = a plain closing.
   double background_close_floor = 0.5;
   // Fill holes of the silhouette (background regions not connected to the image border).
   // Right for objects without through-holes; turn off for a torus seen through its hole.
