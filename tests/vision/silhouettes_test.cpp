@@ -226,6 +226,21 @@ TEST(Silhouettes, BackgroundClosingJoinsDarkPartsButNotTheGapsBetweenLimbs) {
   const Silhouette plain = SilhouetteFromBackground(image8, background8, options);
   EXPECT_GT(cv::countNonZero(plain.mask(cv::Rect(33, 12, 3, 56))), 100);  // the web a plain closing makes
   EXPECT_EQ(cv::countNonZero(plain.mask(cv::Rect(23, 38, 6, 3))), 18);
+
+  // Against a background estimated from the video the subject's parts differ by little over
+  // whole stretches (a shin against a pale floor), so there the closing stays plain: a band
+  // that differs by less than half the threshold (0.02) is joined all the same.
+  cv::Mat faint = image.clone();
+  faint(band).setTo(0.12f);
+  cv::Mat faint8;
+  faint.convertTo(faint8, CV_8U, 255.0);
+  EstimatedBackground estimated;
+  estimated.image = cv::Mat(height, width, CV_32F, cv::Scalar(0.1f));
+  estimated.known = cv::Mat(height, width, CV_8UC1, cv::Scalar(255));
+  options.background_close_floor = 0.5;
+  EXPECT_LT(cv::countNonZero(SilhouetteFromBackground(faint8, background8, options).mask(cv::Rect(23, 38, 6, 3))), 18);
+  const Silhouette from_video = SilhouetteFromEstimatedBackground(faint8, estimated, options);
+  EXPECT_EQ(cv::countNonZero(from_video.mask(cv::Rect(23, 38, 6, 3))), 18) << "the faint band was not joined";
 }
 
 TEST(Silhouettes, OptionsAreChecked) {
