@@ -76,7 +76,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(SilhouetteOptions, source, background_blur_si
                                    shadow_max_gain, shadow_window_radius, background_noise_factor,
                                    working_volume_margin, min_background_fraction, motion_sigma, motion_lambda, motion_window,
                                    motion_threshold, motion_method, motion_min_threshold, estimate_background,
-                                   background_estimate_min_frames, background_estimate_margin, close_radius, background_close_floor,
+                                   background_estimate_min_frames, background_estimate_margin, close_radius, background_close_floor, background_outlines,
                                    fill_holes, min_region_pixels, min_object_pixels)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(StandingEvidenceOptions, enabled, noise_factor, min_threshold)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(PlaneSweepOptions, neighbours, max_neighbour_degrees, consistent_views,

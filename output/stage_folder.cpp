@@ -11,6 +11,7 @@
 #include "core/file_status.h"
 #include "core/json_reader.h"
 #include "geometry/mesh_io.h"
+#include "output/options_json.h"
 #include "output/result_files.h"
 #include "output/result_writer.h"
 #include "output/stage_frames.h"
@@ -129,6 +130,10 @@ void WriteStageReport(const std::string& folder, const StageRecord& record, int 
     report.erase("outlines");
   else
     report["outlines"] = outlines;
+  if (state.background_outlines)
+    report["background_outlines"] = *state.background_outlines;
+  else
+    report.erase("background_outlines");
   WriteJsonFile(ReportPath(folder), report);
 }
 
@@ -224,6 +229,13 @@ StageRecord ReadStageFolderHead(const std::string& folder, const std::string& ex
     if (!(state.image_scales[k] > 0 && state.image_scales[k] <= 1))
       reader.Fail("image_scales[" + std::to_string(k) + "]", "expected a scale in (0, 1]");
   state.outlines = ReadOutlineFiles(folder, report, reader);
+  if (report.contains("background_outlines")) {
+    try {
+      state.background_outlines = report["background_outlines"].get<vision::SilhouetteOptions>();
+    } catch (const std::exception& error) {
+      reader.Fail("background_outlines", std::string("expected silhouette options: ") + error.what());
+    }
+  }
   const fs::path root(folder);
   state.base_mesh = ReadStageMesh(root / "base_mesh.ply");
   state.hierarchy = std::make_shared<const geometry::LoopHierarchy>(

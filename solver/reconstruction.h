@@ -15,6 +15,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -100,6 +101,9 @@ struct StageState {
   // else the projected hulls). A still set against a plain backdrop has them
   // (ShapeInitResult::outlines).
   std::vector<cv::Mat> outlines;
+  // When set, cameras whose silhouettes come from a background image take them, recomputed
+  // per frame with these options, as masks (SilhouetteOptions::background_outlines).
+  std::optional<vision::SilhouetteOptions> background_outlines;
 
   int frame_count() const { return static_cast<int>(control.size()); }
   int reference_index() const { return reference_frame - first_frame; }

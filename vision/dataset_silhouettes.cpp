@@ -106,6 +106,21 @@ std::vector<EstimatedBackground> EstimateBackgrounds(const Dataset& dataset, con
   return estimated;
 }
 
+Silhouette BackgroundImageSilhouette(const Dataset& dataset, int camera, int frame, const SilhouetteOptions& options,
+                                     const std::vector<Camera>* working) {
+  const EvidenceImages evidence{dataset, working};
+  // Colour when both images have colour (distance in colour separates better), else gray.
+  cv::Mat image = evidence.Image(camera, frame), background = evidence.Background(camera);
+  if (image.type() != background.type()) {
+    image = evidence.Gray(camera, frame);
+    background = evidence.BackgroundGray(camera);
+  }
+  Silhouette silhouette =
+      SilhouetteFromBackground(image, background, options, evidence.SurelyBackground(camera, options));
+  silhouette.outline = options.background_outlines;
+  return silhouette;
+}
+
 std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
                                              const SilhouetteOptions& options,
                                              const std::vector<EstimatedBackground>* estimated,
@@ -149,15 +164,7 @@ std::vector<Silhouette> ComputeFrameEvidence(const Dataset& dataset, int frame,
         silhouettes[c] = SilhouetteFromMask(evidence.Mask(c, frame), options);
         break;
       case EvidenceSource::kBackground:
-        // Colour when both images have colour (distance in colour separates better), else gray.
-        {
-          cv::Mat image = evidence.Image(c, frame), background = evidence.Background(c);
-          if (image.type() != background.type()) {
-            image = evidence.Gray(c, frame);
-            background = evidence.BackgroundGray(c);
-          }
-          silhouettes[c] = SilhouetteFromBackground(image, background, options, evidence.SurelyBackground(c, options));
-        }
+        silhouettes[c] = BackgroundImageSilhouette(dataset, c, frame, options, working);
         break;
       default: {
         if (dataset.frame_count() < 2) {

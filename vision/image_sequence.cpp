@@ -1,5 +1,7 @@
 #include "vision/image_sequence.h"
 
+#include <optional>
+
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -21,7 +23,8 @@ cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolatio
 
 ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,
                             EvidenceSource evidence, const std::vector<geometry::TriangleMesh>* hulls,
-                            const std::vector<Camera>* working, const std::vector<cv::Mat>* outlines) {
+                            const std::vector<Camera>* working, const std::vector<cv::Mat>* outlines,
+                            const SilhouetteOptions* background_outlines) {
   if (first_frame < 0 || frame_count < 1 || first_frame + frame_count > dataset.frame_count())
     ThrowError(dataset.directory(), "frames",
                "window [" + std::to_string(first_frame) + ", " + std::to_string(first_frame + frame_count) +
@@ -46,18 +49,29 @@ ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_c
     return Undistorted(working_camera, ResizeToCamera(dataset.Gray(camera, first_frame + frame), working_camera),
                        cv::INTER_LINEAR);
   };
-  std::vector<bool> masks(dataset.camera_count());
+  std::vector<bool> masks(dataset.camera_count()), backgrounds(dataset.camera_count());
   sequence.tight_outline.resize(dataset.camera_count());
   for (int k = 0; k < dataset.camera_count(); ++k) {
-    masks[k] = (evidence == EvidenceSource::kAuto ? AutomaticSource(dataset, k) : evidence) == EvidenceSource::kMask;
-    sequence.tight_outline[k] = masks[k] || (outlines && !(*outlines)[k].empty());
+    const EvidenceSource source = evidence == EvidenceSource::kAuto ? AutomaticSource(dataset, k) : evidence;
+    masks[k] = source == EvidenceSource::kMask;
+    backgrounds[k] = background_outlines && source == EvidenceSource::kBackground;
+    sequence.tight_outline[k] = masks[k] || backgrounds[k] || (outlines && !(*outlines)[k].empty());
   }
-  sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras, outlines](int camera, int frame) {
+  std::optional<SilhouetteOptions> background_options;
+  if (background_outlines) background_options = *background_outlines;
+  sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras, outlines, backgrounds,
+                         background_options](int camera, int frame) {
     const Camera& working_camera = cameras[camera];
     if (masks[camera])
       return Undistorted(working_camera,
                          ResizeToCamera(dataset.Mask(camera, first_frame + frame), working_camera, true),
                          cv::INTER_NEAREST);
+    if (backgrounds[camera])
+      return Undistorted(
+          working_camera,
+          ResizeToCamera(BackgroundImageSilhouette(dataset, camera, first_frame + frame, *background_options).mask,
+                         working_camera, true),
+          cv::INTER_NEAREST);
     if (outlines && !(*outlines)[camera].empty())
       return Undistorted(working_camera, ResizeToCamera((*outlines)[camera], working_camera, true),
                          cv::INTER_NEAREST);

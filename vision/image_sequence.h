@@ -61,6 +61,7 @@ ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_c
                             EvidenceSource evidence = EvidenceSource::kAuto,
                             const std::vector<geometry::TriangleMesh>* hulls = nullptr,
                             const std::vector<Camera>* working = nullptr,
-                            const std::vector<cv::Mat>* outlines = nullptr);
+                            const std::vector<cv::Mat>* outlines = nullptr,
+                            const SilhouetteOptions* background_outlines = nullptr);
 
 }  // namespace subflow::vision

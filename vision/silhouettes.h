@@ -192,6 +192,10 @@ struct SilhouetteOptions {
   // nor for motion evidence, whose closing fills the flat, untextured inside of the object,
   // where θ is 0. 0 = a plain closing.
   double background_close_floor = 0.5;
+  // A background image's silhouettes are the object's outlines (Silhouette::outline): the
+  // hull is carved as from masks, and the later stages take them as masks, recomputed per
+  // frame (ImageSequence). Experimental (branch bg-outlines).
+  bool background_outlines = true;
   // Fill holes of the silhouette (background regions not connected to the image border).
   // Right for objects without through-holes; turn off for a torus seen through its hole.
   bool fill_holes = true;
@@ -321,6 +325,11 @@ EvidenceSource AutomaticSource(const Dataset& dataset, int camera);
 // evidence and fewer than `min_cameras` of them have a non-empty silhouette (a frame of a
 // mask-less dataset in which nothing moves within the motion window).
 bool LacksEvidence(const std::vector<Silhouette>& silhouettes, int min_cameras = 1);
+
+// The silhouette of camera `camera` at `frame` from its background image (which must
+// exist), as ComputeFrameEvidence makes it (`working` likewise).
+Silhouette BackgroundImageSilhouette(const Dataset& dataset, int camera, int frame, const SilhouetteOptions& options,
+                                     const std::vector<Camera>* working = nullptr);
 
 // Silhouettes of every camera of `dataset` at `frame` (index = camera index), cameras in
 // parallel. Source per camera: options.source, or for kAuto masks if has_masks(), else

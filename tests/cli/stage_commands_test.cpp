@@ -243,6 +243,35 @@ TEST(StageCommands, AStillOnAPlainBackdropHandsItsOutlinesToTheLaterStages) {
   }
 }
 
+// A dataset with background images and no masks: the later stages take each frame's
+// background-image silhouette, recomputed as the shape stage made it, as the camera's mask
+// (tight outlines); the shape stage folder keeps the options that make them.
+TEST(StageCommands, BackgroundImageSilhouettesAreTheLaterStagesOutlines) {
+  const fs::path work = Scratch().Subdirectory("background_outlines");
+  const fs::path dataset = work / "take";
+  RunOk("synth sphere --out " + Quoted(dataset) + " --cameras 6 --frames 3 --width 160 --height 120 --no-masks");
+  RunOk("shape " + Quoted(dataset) + " --out " + Quoted(work / "shape") + kShape);
+  const nlohmann::json report = ReadReport(work / "shape");
+  ASSERT_TRUE(report.contains("background_outlines"));
+
+  const vision::Dataset opened(dataset.string());
+  const output::StageRecord record = output::ReadStageFolder((work / "shape").string(), "shape");
+  ASSERT_TRUE(record.state.background_outlines.has_value());
+  const vision::ImageSequence images = solver::StageImages(opened, record.state);
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(images.tight_outline.at(k), 1) << "camera " << k;
+    for (int f = 0; f < 3; ++f) {
+      const cv::Mat expected = vision::ResizeToCamera(
+          vision::BackgroundImageSilhouette(opened, k, f, *record.state.background_outlines).mask, images.cameras[k],
+          true);
+      const cv::Mat silhouette = images.silhouette(k, f);
+      ASSERT_EQ(silhouette.size(), expected.size());
+      EXPECT_GT(cv::countNonZero(expected), 300) << "camera " << k << ", frame " << f;
+      EXPECT_EQ(cv::countNonZero(silhouette != expected), 0) << "camera " << k << ", frame " << f;
+    }
+  }
+}
+
 TEST(StageCommands, AnUnfinishedOrWrongStageFolderIsRefused) {
   const fs::path work = Scratch().Subdirectory("refused");
   const fs::path unfinished = work / "unfinished";
