@@ -194,7 +194,8 @@ struct SilhouetteOptions {
   double background_close_floor = 0.5;
   // A background image's silhouettes are the object's outlines (Silhouette::outline): the
   // hull is carved as from masks, and the later stages take them as masks, recomputed per
-  // frame (ImageSequence). Experimental (branch bg-outlines).
+  // frame (ImageSequence, StageState::background_outlines; docs/shape.md, "Gaps between
+  // limbs"). false = the projected hull bounds them, as before 2026-12-07.
   bool background_outlines = true;
   // Fill holes of the silhouette (background regions not connected to the image border).
   // Right for objects without through-holes; turn off for a torus seen through its hole.
@@ -226,7 +227,8 @@ struct Silhouette {
   bool empty = true;      // object_pixels < options.min_object_pixels
   // A measured silhouette that is the object's own outline, as a mask is: the difference to
   // a plain backdrop (solver/shape/shape_init.cpp, BackdropSilhouettes), where whatever
-  // differs from the backdrop is the object. Carved without the hull's cleaning, and the
+  // differs from the backdrop is the object, or to a background image
+  // (SilhouetteOptions::background_outlines). Carved without the hull's cleaning, and the
   // refinement pulls the surface's rim onto it, as for masks (docs/shape.md, "Gaps between
   // limbs, and a backdrop's silhouettes as outlines"). Masks are outlines whatever this says.
   bool outline = false;
