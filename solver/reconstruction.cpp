@@ -80,17 +80,16 @@ geometry::Positions StageState::Surface(int i) const {
 }
 
 vision::ImageSequence StageImages(const vision::Dataset& dataset, const StageState& state) {
-  if (state.image_scales.empty())
-    return vision::DatasetImages(dataset, state.first_frame, state.frame_count(), state.evidence, &state.hulls,
-                                 nullptr, &state.outlines,
-                                 state.background_outlines ? &*state.background_outlines : nullptr);
-  if (static_cast<int>(state.image_scales.size()) != dataset.camera_count())
-    ThrowError("stage state", "image_scales",
-               "expected one per camera (" + std::to_string(dataset.camera_count()) + "), found " +
-                   std::to_string(state.image_scales.size()));
-  const std::vector<vision::Camera> working = vision::ScaledCameras(dataset.cameras(), state.image_scales);
+  std::vector<vision::Camera> working;
+  if (!state.image_scales.empty()) {
+    if (static_cast<int>(state.image_scales.size()) != dataset.camera_count())
+      ThrowError("stage state", "image_scales",
+                 "expected one per camera (" + std::to_string(dataset.camera_count()) + "), found " +
+                     std::to_string(state.image_scales.size()));
+    working = vision::ScaledCameras(dataset.cameras(), state.image_scales);
+  }
   return vision::DatasetImages(dataset, state.first_frame, state.frame_count(), state.evidence, &state.hulls,
-                               &working, &state.outlines,
+                               working.empty() ? nullptr : &working, &state.outlines,
                                state.background_outlines ? &*state.background_outlines : nullptr);
 }
 
@@ -134,10 +133,13 @@ StageState RunShapeStage(const vision::Dataset& dataset, const ShapeInitOptions&
   state.image_scales =
       WorkingImageScales(dataset, state.Hierarchy(), figures->reference_control, options.image_edge_pixels);
   state.outlines = figures->outlines;
-  if (options.silhouettes.background_outlines && options.silhouettes.source == vision::EvidenceSource::kAuto)
-    for (int k = 0; k < dataset.camera_count(); ++k)
-      if (vision::AutomaticSource(dataset, k) == vision::EvidenceSource::kBackground)
-        state.background_outlines = options.silhouettes;
+  bool any_background_image = false;
+  for (int k = 0; k < dataset.camera_count(); ++k)
+    any_background_image =
+        any_background_image || vision::AutomaticSource(dataset, k) == vision::EvidenceSource::kBackground;
+  if (options.silhouettes.background_outlines && options.silhouettes.source == vision::EvidenceSource::kAuto &&
+      any_background_image)
+    state.background_outlines = options.silhouettes;
   return state;
 }
 
