@@ -5,13 +5,13 @@
 #include <mutex>
 #include <string>
 
-#include <tbb/parallel_invoke.h>
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include "core/error.h"
 #include "core/stopwatch.h"
+#include "core/task_errors.h"
 #include "geometry/closest_point.h"
 #include "geometry/mean_edge_length.h"
 #include "geometry/multires_shape.h"
@@ -258,9 +258,9 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   // is computed as it would be alone (every parallel sum in the step has a fixed order):
   // side by side, one chain's serial parts (the solver's level loop, ray casts, decoding)
   // overlap the other's parallel ones. An exception in one (an interrupt, a bad frame) is
-  // rethrown here once the other has stopped too.
+  // rethrown here once the other has stopped too (core/task_errors.h).
   if (options.concurrent_chains) {
-    tbb::parallel_invoke([&] { chain(+1); }, [&] { chain(-1); });
+    RunSideBySide([&] { chain(+1); }, [&] { chain(-1); });
   } else {
     chain(+1);
     chain(-1);

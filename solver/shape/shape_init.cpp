@@ -9,14 +9,14 @@
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include "core/error.h"
 #include "core/stopwatch.h"
+#include "core/task_errors.h"
 #include "geometry/closest_point.h"
 #include "geometry/mean_edge_length.h"
-#include "core/error.h"
 #include "vision/plain_backdrop.h"
 #include "vision/silhouettes.h"
 #include "vision/working_scale.h"
@@ -124,29 +124,37 @@ struct HullStage {
       int i;
       bool carved;
     };
+    // No exception may reach TBB (core/task_errors.h): once a step threw, no frame enters
+    // and the frames under way skip their remaining steps.
+    TaskErrors errors;
     tbb::parallel_pipeline(
         static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()) + 1,
-        tbb::make_filter<void, Token>(tbb::filter_mode::serial_in_order,
-                                      [&](tbb::flow_control& control) {
-                                        if (next == count) {
-                                          control.stop();
-                                          return Token{-1, false};
-                                        }
-                                        Carve(silhouette_options, still, next, frames, has_evidence, all_empty);
-                                        const Token token{next, (*has_evidence)[next]};
-                                        ++next;
-                                        return token;
-                                      }) &
+        tbb::make_filter<void, Token>(
+            tbb::filter_mode::serial_in_order,
+            [&](tbb::flow_control& control) {
+              const int i = next++;
+              if (i >= count || errors.failed() ||
+                  !errors.Run([&] { Carve(silhouette_options, still, i, frames, has_evidence, all_empty); })) {
+                control.stop();
+                return Token{-1, false};
+              }
+              return Token{i, (*has_evidence)[i]};
+            }) &
             tbb::make_filter<Token, Token>(tbb::filter_mode::parallel,
                                            [&](Token token) {
-                                             if (token.carved) ExtractHull(&(*frames)[token.i], &hulls[token.i]);
+                                             if (token.carved && !errors.failed())
+                                               errors.Run([&] { ExtractHull(&(*frames)[token.i], &hulls[token.i]); });
                                              return token;
                                            }) &
             tbb::make_filter<Token, void>(tbb::filter_mode::serial_in_order, [&](Token token) {
-              if (token.carved) store->StoreHull((*frames)[token.i].frame, hulls[token.i]);
-              hulls[token.i] = geometry::TriangleMesh();
-              ProgressUpdate(progress, token.i + 1);
+              if (errors.failed()) return;
+              errors.Run([&] {
+                if (token.carved) store->StoreHull((*frames)[token.i].frame, hulls[token.i]);
+                hulls[token.i] = geometry::TriangleMesh();
+                ProgressUpdate(progress, token.i + 1);
+              });
             }));
+    errors.RethrowFirst();
     ProgressEnd(progress);
   }
 
@@ -347,7 +355,7 @@ geometry::Positions FitEveryFrame(const ShapeInitOptions& options, ShapeFrameSto
     geometry::Positions base = reference.front();
     for (int i = reference_index + direction; i >= 0 && i < count; i += direction) base = fit(i, base).front();
   };
-  tbb::parallel_invoke([&] { side(+1); }, [&] { side(-1); });
+  RunSideBySide([&] { side(+1); }, [&] { side(-1); });  // core/task_errors.h
   ProgressEnd(progress);
   return reference.back();
 }

@@ -9,10 +9,10 @@
 #include <Eigen/Geometry>
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
-#include <tbb/parallel_invoke.h>
 
 #include "core/error.h"
 #include "core/stopwatch.h"
+#include "core/task_errors.h"
 #include "geometry/multires_shape.h"
 #include "solver/stereo/patch_levels.h"
 #include "solver/stereo/refinement_window.h"
@@ -171,8 +171,8 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
     if (plan.halves.size() == 1) {
       run(plan.halves[0], caches[0], &moved[0], &tallies[0]);
     } else {
-      tbb::parallel_invoke([&] { run(plan.halves[0], caches[0], &moved[0], &tallies[0]); },
-                           [&] { run(plan.halves[1], caches[1], &moved[1], &tallies[1]); });
+      RunSideBySide([&] { run(plan.halves[0], caches[0], &moved[0], &tallies[0]); },  // core/task_errors.h
+                    [&] { run(plan.halves[1], caches[1], &moved[1], &tallies[1]); });
       run(plan.seam, caches[0], &moved[0], &tallies[0]);
     }
     report.parameters = report.residual_blocks = report.iterative_windows = 0;  // the last round's
