@@ -155,19 +155,28 @@ WindowGains FitWindowGains(const cv::Mat& bb, const cv::Mat& ab, const cv::Mat& 
   return gains;
 }
 
-// Of the gains the windows of `gains` lend pixel (x, y), the one nearest `own` (the gain
-// that fits p alone), kept in *nearest when nearer than it already is.
-void NearestLentGain(const WindowGains& gains, int x, int y, float own, float* nearest) {
-  const int r = gains.shape.radius;
-  for (const cv::Point& offset : gains.shape.neighbours) {
-    const int qx = x + offset.x, qy = y + offset.y;
-    if (qx < 0 || qy < 0 || qx >= gains.alpha.cols || qy >= gains.alpha.rows) continue;
-    const float alpha = gains.alpha.at<float>(qy, qx);
-    if (std::isnan(alpha)) continue;
+// For each pixel x of row y: of the gains the windows of `gains` lend it, the one nearest
+// own[x] (the gain that fits the pixel alone), kept in nearest[x] when nearer than it
+// already is. Window by window along the row, so that each pixel compares the same gains
+// in the same order as one pixel at a time would, in a loop without divisions or branches
+// on the image's border.
+void NearestLentGains(const WindowGains& gains, int y, const float* own, float* nearest) {
+  const int r = gains.shape.radius, cols = gains.alpha.cols;
+  for (const cv::Point& offset : gains.shape.neighbours) {  // q = p + offset
+    const int qy = y + offset.y;
+    if (qy < 0 || qy >= gains.alpha.rows) continue;
     // The plane at the window's point nearest p (no extrapolation beyond the window).
-    const float u = std::clamp(float(x - qx) / r, -1.0f, 1.0f), v = std::clamp(float(y - qy) / r, -1.0f, 1.0f);
-    const float gain = alpha + gains.beta.at<float>(qy, qx) * u + gains.gamma.at<float>(qy, qx) * v;
-    if (!(std::abs(gain - own) >= std::abs(*nearest - own))) *nearest = gain;
+    const float u = std::clamp(float(-offset.x) / r, -1.0f, 1.0f), v = std::clamp(float(-offset.y) / r, -1.0f, 1.0f);
+    const float* alpha = gains.alpha.ptr<float>(qy);
+    const float* beta = gains.beta.ptr<float>(qy);
+    const float* gamma = gains.gamma.ptr<float>(qy);
+    const int first = std::max(0, -offset.x), last = std::min(cols, cols - offset.x);
+    for (int x = first; x < last; ++x) {  // branch-free: the compiler vectorizes it
+      const int qx = x + offset.x;
+      const float gain = alpha[qx] + beta[qx] * u + gamma[qx] * v;  // NaN where no shadow window
+      const bool nearer = (gain == gain) & !(std::abs(gain - own[x]) >= std::abs(nearest[x] - own[x]));
+      nearest[x] = nearer ? gain : nearest[x];
+    }
   }
 }
 
@@ -194,20 +203,22 @@ cv::Mat ShadowRobustDifference(const cv::Mat& image, const cv::Mat& background, 
   // e(p): the misfit of p under the gain nearest its own among those lent by the shadow
   // windows around it; m = min(d, e).
   cv::Mat robust = plain.clone();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> own(image.cols), gain(image.cols);
   for (int y = 0; y < image.rows; ++y) {
     const float* ap = a.ptr<float>(y);
     const float* bp = b.ptr<float>(y);
     const float* abp = ab.ptr<float>(y);
     const float* bbp = bb.ptr<float>(y);
     float* m = robust.ptr<float>(y);
+    for (int x = 0; x < image.cols; ++x) own[x] = bbp[x] > 0 ? abp[x] / bbp[x] : 1.0f;
+    std::fill(gain.begin(), gain.end(), nan);
+    for (const WindowGains& gains : fitted) NearestLentGains(gains, y, own.data(), gain.data());
     for (int x = 0; x < image.cols; ++x) {
-      const float own = bbp[x] > 0 ? abp[x] / bbp[x] : 1.0f;
-      float gain = std::numeric_limits<float>::quiet_NaN();
-      for (const WindowGains& gains : fitted) NearestLentGain(gains, x, y, own, &gain);
-      if (std::isnan(gain)) continue;  // no shadow window near p
+      if (std::isnan(gain[x])) continue;  // no shadow window near p
       float squared = 0;
       for (int c = 0; c < channels; ++c) {
-        const float r = ap[x * channels + c] - gain * bp[x * channels + c];
+        const float r = ap[x * channels + c] - gain[x] * bp[x * channels + c];
         squared += r * r;
       }
       m[x] = std::min(m[x], std::sqrt(squared / channels));
