@@ -1,7 +1,13 @@
 #include "vision/image_sequence.h"
 
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
+#include <utility>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -16,6 +22,52 @@ void ImageSequence::Check(const std::string& stage) const {
   if (frame_count < 1) ThrowError(stage, "frames", "needs at least one frame");
   if (!gray) ThrowError(stage, "gray images", "no image loader given");
 }
+
+namespace {
+
+// Silhouettes computed from a background image (a shadow-robust difference: ~20 ms a
+// camera at 320×240), kept so that each is computed once per sequence, not once per
+// refinement level, round and chain. Kept PNG-compressed (a binary mask of 320×240 takes a
+// few KB) up to a byte budget; past it the oldest go first, so a long take costs bounded
+// memory and only recomputes.
+class SilhouetteMemo {
+ public:
+  explicit SilhouetteMemo(std::size_t budget_bytes) : budget_(budget_bytes) {}
+
+  cv::Mat Get(int camera, int frame, const std::function<cv::Mat()>& compute) {
+    const std::pair<int, int> key(camera, frame);
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      const auto it = png_.find(key);
+      if (it != png_.end()) return cv::imdecode(it->second, cv::IMREAD_UNCHANGED);
+    }
+    cv::Mat mask = compute();  // outside the lock: other cameras' in parallel
+    std::vector<uchar> png;
+    if (mask.empty() || !cv::imencode(".png", mask, png) || png.size() > budget_) return mask;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (png_.count(key)) return mask;  // computed meanwhile by another thread, the same
+    while (bytes_ + png.size() > budget_ && !order_.empty()) {
+      bytes_ -= png_[order_.front()].size();
+      png_.erase(order_.front());
+      order_.pop_front();
+    }
+    bytes_ += png.size();
+    order_.push_back(key);
+    png_.emplace(key, std::move(png));
+    return mask;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::pair<int, int>, std::vector<uchar>> png_;
+  std::deque<std::pair<int, int>> order_;  // first kept first
+  std::size_t bytes_ = 0;
+  const std::size_t budget_;
+};
+
+constexpr std::size_t kSilhouetteMemoBytes = std::size_t{64} << 20;
+
+}  // namespace
 
 cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolation) {
   return camera.HasDistortion() ? camera.UndistortImage(image, interpolation) : image;
@@ -59,19 +111,19 @@ ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_c
   }
   std::optional<SilhouetteOptions> background_options;
   if (background_outlines) background_options = *background_outlines;
-  sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras, outlines, backgrounds,
-                         background_options](int camera, int frame) {
+  const auto memo = std::make_shared<SilhouetteMemo>(kSilhouetteMemoBytes);
+  sequence.silhouette = [&dataset, first_frame, hulls, masks, cameras, outlines, backgrounds, background_options,
+                         memo](int camera, int frame) {
     const Camera& working_camera = cameras[camera];
     if (masks[camera])
       return Undistorted(working_camera,
                          ResizeToCamera(dataset.Mask(camera, first_frame + frame), working_camera, true),
                          cv::INTER_NEAREST);
     if (backgrounds[camera])
-      return Undistorted(
-          working_camera,
-          ResizeToCamera(BackgroundImageSilhouette(dataset, camera, first_frame + frame, *background_options).mask,
-                         working_camera, true),
-          cv::INTER_NEAREST);
+      return memo->Get(camera, frame, [&] {
+        const Silhouette silhouette = BackgroundImageSilhouette(dataset, camera, first_frame + frame, *background_options);
+        return Undistorted(working_camera, ResizeToCamera(silhouette.mask, working_camera, true), cv::INTER_NEAREST);
+      });
     if (outlines && !(*outlines)[camera].empty())
       return Undistorted(working_camera, ResizeToCamera((*outlines)[camera], working_camera, true),
                          cv::INTER_NEAREST);

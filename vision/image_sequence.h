@@ -56,7 +56,10 @@ cv::Mat Undistorted(const Camera& camera, const cv::Mat& image, int interpolatio
 // are; null = the stored cameras and sizes. `outlines` (may be null or empty; else one per
 // camera, which must outlive the sequence): a camera without a mask whose outline is not
 // empty takes it as its mask in every frame (CV_8UC1 in raw image coordinates, resized to
-// the working size at half coverage), a tight outline.
+// the working size at half coverage), a tight outline. `background_outlines` (may be null):
+// a camera whose evidence is a background image takes, as its tight outline, each frame's
+// background-image silhouette made with these options (BackgroundImageSilhouette; each
+// computed once per sequence and kept, compressed, within a fixed memory budget).
 ImageSequence DatasetImages(const Dataset& dataset, int first_frame, int frame_count,
                             EvidenceSource evidence = EvidenceSource::kAuto,
                             const std::vector<geometry::TriangleMesh>* hulls = nullptr,

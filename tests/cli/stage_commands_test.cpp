@@ -270,6 +270,17 @@ TEST(StageCommands, BackgroundImageSilhouettesAreTheLaterStagesOutlines) {
       EXPECT_EQ(cv::countNonZero(silhouette != expected), 0) << "camera " << k << ", frame " << f;
     }
   }
+  // Asked again (the refinement asks at every level): the kept silhouettes, the same pixels.
+  for (int k = 5; k >= 0; --k)
+    for (int f = 2; f >= 0; --f) {
+      const cv::Mat expected = vision::ResizeToCamera(
+          vision::BackgroundImageSilhouette(opened, k, f, *record.state.background_outlines).mask, images.cameras[k],
+          true);
+      const cv::Mat again = images.silhouette(k, f);
+      ASSERT_EQ(again.size(), expected.size());
+      ASSERT_EQ(again.type(), expected.type());
+      EXPECT_EQ(cv::countNonZero(again != expected), 0) << "camera " << k << ", frame " << f << ", asked again";
+    }
 }
 
 TEST(StageCommands, AnUnfinishedOrWrongStageFolderIsRefused) {
