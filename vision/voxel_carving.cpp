@@ -55,16 +55,21 @@ inline double BoxSum(const double* sums, size_t stride, int x0, int x1, int y0, 
 // evidence all 0 (mean 0) or all 1 (mean = 1), every voxel is a miss or a hit without
 // looking at it. Only blocks straddling the silhouette's contour are visited voxel by
 // voxel, so the cost follows the object's surface, not its volume.
+// A distorted camera whose corners are kept (kept[u] for used[u], may be null) takes them
+// from there, and is tested block by block on the box of all the block's corners (its
+// edges curve: the outer 8 do not bound it).
 void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingCamera>& used,
-                  const ScalarVolume& grid, double threshold, float margin, int max_misses,
-                  std::vector<uint16_t>* hits, std::vector<uint16_t>* misses) {
+                  const std::vector<const GridCornerPixels*>& kept, const ScalarVolume& grid, double threshold,
+                  float margin, int max_misses, std::vector<uint16_t>* hits, std::vector<uint16_t>* misses) {
   constexpr int kSlab = 4, kBlock = 8;
   tbb::parallel_for(tbb::blocked_range<int>(0, grid.nz, kSlab), [&](const tbb::blocked_range<int>& range) {
     const int k0 = range.begin(), k1 = range.end();
     constexpr size_t kCorners = (kBlock + 1) * (kBlock + 1) * (kSlab + 1);
     float us[kCorners], vs[kCorners];
-    for (const CarvingCamera& carving_camera : used) {
+    for (std::size_t u = 0; u < used.size(); ++u) {
+      const CarvingCamera& carving_camera = used[u];
       const Camera& camera = cameras[carving_camera.index];
+      const GridCornerPixels* corner_pixels = kept[u];
       const int width = camera.width(), height = camera.height();
       const double* sums = carving_camera.integral.ptr<double>();
       const size_t stride = width + 1;
@@ -87,31 +92,47 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
         for (int i_begin = 0; i_begin < grid.nx; i_begin += kBlock) {
           const int j_end = std::min(j_begin + kBlock, grid.ny), i_end = std::min(i_begin + kBlock, grid.nx);
           const size_t row = i_end - i_begin + 1, plane = row * (j_end - j_begin + 1);
+          // Every voxel of the block a hit (or a miss) when the evidence over the block's
+          // footprint (x_min..y_max) grown by the margin is all 1 (or all 0).
+          auto whole_block = [&](float x_min, float x_max, float y_min, float y_max) {
+            const int x0 = std::max(0, static_cast<int>(std::floor(x_min - margin)));
+            const int x1 = std::min(width - 1, static_cast<int>(std::ceil(x_max + margin)));
+            const int y0 = std::max(0, static_cast<int>(std::floor(y_min - margin)));
+            const int y1 = std::min(height - 1, static_cast<int>(std::ceil(y_max + margin)));
+            const double sum = BoxSum(sums, stride, x0, x1, y0, y1);
+            const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
+            if (sum > 0 && sum < area) return false;
+            std::vector<uint16_t>& counts = sum <= 0 ? *misses : *hits;
+            for (int k = k0; k < k1; ++k)
+              for (int j = j_begin; j < j_end; ++j)
+                for (size_t v = grid.Index(i_begin, j, k), end = v + (i_end - i_begin); v < end; ++v) ++counts[v];
+            return true;
+          };
+          float x_min, x_max, y_min, y_max;
           if (pinhole) {
             // The block's 8 outer corners, stored where the block's full corner grid would put them.
             const size_t di = row - 1, dj = plane - row, dk = (k1 - k0) * plane;
             const size_t corners[8] = {0, di, dj, di + dj, dk, dk + di, dk + dj, dk + di + dj};
             for (size_t c : corners)
               projector.ProjectCorner(i_begin + (c % row), j_begin + (c % plane) / row, k0 + c / plane, &us[c], &vs[c]);
-            float x_min, x_max, y_min, y_max;
-            if (footprint(corners, &x_min, &x_max, &y_min, &y_max)) {
-              const int x0 = std::max(0, static_cast<int>(std::floor(x_min - margin)));
-              const int x1 = std::min(width - 1, static_cast<int>(std::ceil(x_max + margin)));
-              const int y0 = std::max(0, static_cast<int>(std::floor(y_min - margin)));
-              const int y1 = std::min(height - 1, static_cast<int>(std::ceil(y_max + margin)));
-              const double sum = BoxSum(sums, stride, x0, x1, y0, y1);
-              const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
-              if (sum <= 0 || sum >= area) {
-                std::vector<uint16_t>& counts = sum <= 0 ? *misses : *hits;
-                for (int k = k0; k < k1; ++k)
-                  for (int j = j_begin; j < j_end; ++j)
-                    for (size_t v = grid.Index(i_begin, j, k), end = v + (i_end - i_begin); v < end; ++v)
-                      ++counts[v];
-                continue;
+            if (footprint(corners, &x_min, &x_max, &y_min, &y_max) && whole_block(x_min, x_max, y_min, y_max)) continue;
+            projector.ProjectCorners(i_begin, i_end, j_begin, j_end, k0, k1, us, vs);
+          } else if (corner_pixels) {
+            size_t c = 0;
+            for (int k = k0; k <= k1; ++k)
+              for (int j = j_begin; j <= j_end; ++j) {
+                const size_t first = corner_pixels->Index(i_begin, j, k);
+                std::copy_n(corner_pixels->u.data() + first, row, us + c);
+                std::copy_n(corner_pixels->v.data() + first, row, vs + c);
+                c += row;
               }
-            }
+            x_min = *std::min_element(us, us + c), x_max = *std::max_element(us, us + c);
+            y_min = *std::min_element(vs, vs + c), y_max = *std::max_element(vs, vs + c);
+            const bool inside = x_min >= -0.5f && y_min >= -0.5f && x_max < width - 0.5f && y_max < height - 0.5f;
+            if (inside && whole_block(x_min, x_max, y_min, y_max)) continue;
+          } else {
+            projector.ProjectCorners(i_begin, i_end, j_begin, j_end, k0, k1, us, vs);
           }
-          projector.ProjectCorners(i_begin, i_end, j_begin, j_end, k0, k1, us, vs);
           for (int k = k0; k < k1; ++k)
             for (int j = j_begin; j < j_end; ++j)
               for (int i = i_begin; i < i_end; ++i) {
@@ -258,9 +279,26 @@ ScalarVolume MakeVoxelGrid(const Bounds& bounds, int resolution) {
   return ScalarVolume(origin, spacing, counts[0], counts[1], counts[2], 0.0f);
 }
 
+const GridCornerPixels* CornerPixelCache::Get(int index, const Camera& camera, const ScalarVolume& grid) {
+  if (!camera.HasDistortion()) return nullptr;
+  const std::vector<double> key = {grid.origin.x(), grid.origin.y(), grid.origin.z(), grid.spacing,
+                                   double(grid.nx), double(grid.ny), double(grid.nz)};
+  if (key != grid_) {  // another grid: nothing kept applies
+    grid_ = key;
+    cameras_.clear();
+    bytes_ = 0;
+  }
+  const auto kept = cameras_.find(index);
+  if (kept != cameras_.end()) return &kept->second;
+  const std::size_t bytes = 2 * sizeof(float) * std::size_t(grid.nx + 1) * (grid.ny + 1) * (grid.nz + 1);
+  if (bytes_ + bytes > budget_) return nullptr;
+  bytes_ += bytes;
+  return &cameras_.emplace(index, ProjectGridCorners(camera, grid)).first->second;
+}
+
 CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
                           const std::vector<Silhouette>& silhouettes, const Bounds& bounds,
-                          const VoxelCarvingOptions& options, int frame) {
+                          const VoxelCarvingOptions& options, int frame, CornerPixelCache* corners) {
   options.Check();
   const std::string where = FrameLabel(frame);
   if (silhouettes.size() != cameras.size())
@@ -324,7 +362,10 @@ CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
   tbb::task_arena arena(options.threads == 0 ? tbb::task_arena::automatic : options.threads);
   arena.execute([&] {
     std::vector<uint16_t> hits(occupancy.size(), 0), misses(occupancy.size(), 0);
-    CountSupport(cameras, used, occupancy, options.evidence_threshold,
+    std::vector<const GridCornerPixels*> kept(used.size(), nullptr);
+    if (corners)
+      for (std::size_t u = 0; u < used.size(); ++u) kept[u] = corners->Get(used[u].index, cameras[used[u].index], occupancy);
+    CountSupport(cameras, used, kept, occupancy, options.evidence_threshold,
                  static_cast<float>(options.footprint_margin), result.max_misses, &hits, &misses);
     for (size_t v = 0; v < occupancy.size(); ++v)
       occupied.values[v] = hits[v] >= options.min_cameras && misses[v] <= result.max_misses;

@@ -49,6 +49,7 @@
 #include <array>
 #include <cstddef>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -200,11 +201,31 @@ VoxelCarvingOptions ResolveCarvingOptions(const std::vector<Camera>& cameras, co
 // `bounds`), ceil(size / spacing) voxels per axis, centred on the bounds.
 geometry::ScalarVolume MakeVoxelGrid(const Bounds& bounds, int resolution);
 
+// The corner pixels of the distorted cameras, kept between the frames of a take carved in
+// one grid by one rig: a distorted camera's corner costs a Camera::Project (a pinhole
+// camera's a multiply-add, not kept), the same for every frame. Within a byte budget;
+// cameras past it are projected per frame. Kept values are ProjectCorner's, so a carving
+// is the same with the cache as without it.
+class CornerPixelCache {
+ public:
+  explicit CornerPixelCache(std::size_t budget_bytes = std::size_t{256} << 20) : budget_(budget_bytes) {}
+  // The corners of camera `index` (`camera`) in `grid`, projected on the first call for
+  // this grid; null for a camera without distortion or past the budget. Not thread-safe.
+  const GridCornerPixels* Get(int index, const Camera& camera, const geometry::ScalarVolume& grid);
+
+ private:
+  std::vector<double> grid_;  // origin, spacing and sizes of the grid the corners are of
+  std::map<int, GridCornerPixels> cameras_;  // by camera index
+  std::size_t bytes_ = 0;
+  const std::size_t budget_;
+};
+
 // Carves, cleans and measures (see the file comment). silhouettes[k] belongs to
 // cameras[k] and must have its size. `frame` only labels messages and the result.
+// `corners` (may be null): the distorted cameras' corner pixels, kept across frames.
 CarvingResult CarveVoxels(const std::vector<Camera>& cameras,
                           const std::vector<Silhouette>& silhouettes, const Bounds& bounds,
-                          const VoxelCarvingOptions& options, int frame = 0);
+                          const VoxelCarvingOptions& options, int frame = 0, CornerPixelCache* corners = nullptr);
 
 // ComputeSilhouettes + CarveVoxels on the dataset's cameras and bounds at one frame.
 CarvingResult CarveFrame(const Dataset& dataset, int frame,

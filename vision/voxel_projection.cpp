@@ -5,6 +5,8 @@
 #include <limits>
 #include <vector>
 
+#include <tbb/parallel_for.h>
+
 #include "core/error.h"
 
 namespace subflow::vision {
@@ -94,6 +96,20 @@ bool VoxelCornerProjector::ProjectCorner(int i, int j, int k, float* u, float* v
   *u = static_cast<float>(p.x());
   *v = static_cast<float>(p.y());
   return true;
+}
+
+GridCornerPixels ProjectGridCorners(const Camera& camera, const geometry::ScalarVolume& grid) {
+  GridCornerPixels corners;
+  corners.nx = grid.nx, corners.ny = grid.ny, corners.nz = grid.nz;
+  const std::size_t count = corners.Index(0, 0, grid.nz + 1);
+  corners.u.resize(count);
+  corners.v.resize(count);
+  const VoxelCornerProjector projector(camera, grid);
+  tbb::parallel_for(0, grid.nz + 1, [&](int k) {
+    const std::size_t first = corners.Index(0, 0, k);
+    projector.ProjectCorners(0, grid.nx, 0, grid.ny, k, k, corners.u.data() + first, corners.v.data() + first);
+  });
+  return corners;
 }
 
 void VoxelCornerProjector::ProjectCorners(int i0, int i1, int j0, int j1, int k0, int k1, float* us,

@@ -10,6 +10,7 @@
 // the centre of the top-left pixel, because silhouettes are in raw image coordinates.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include <Eigen/Core>
@@ -48,6 +49,19 @@ class VoxelCornerProjector {
   bool distorted_;
   Eigen::Vector3d h0_, dh_i_, dh_j_, dh_k_;  // h(i, j, k) = h0 + i dh_i + j dh_j + k dh_k
 };
+
+// The pixels of every corner of a grid in one camera (ProjectCorner's values, kInvalidPixel
+// where it cannot project), corner (i, j, k) at i + (nx + 1)(j + (ny + 1) k).
+struct GridCornerPixels {
+  int nx = 0, ny = 0, nz = 0;  // the grid's voxels per axis (corners: one more)
+  std::vector<float> u, v;
+  std::size_t Index(int i, int j, int k) const {
+    return static_cast<std::size_t>(i) + static_cast<std::size_t>(nx + 1) * (j + static_cast<std::size_t>(ny + 1) * k);
+  }
+  std::size_t Bytes() const { return (u.size() + v.size()) * sizeof(float); }
+};
+// Projects them all (parallel over the grid's planes).
+GridCornerPixels ProjectGridCorners(const Camera& camera, const geometry::ScalarVolume& grid);
 
 // Whether the pixel of world point X (Camera::Project, same validity rule as above) lies
 // in the image; false behind the camera.

@@ -127,6 +127,7 @@ struct HullStage {
     // No exception may reach TBB (core/task_errors.h): once a step threw, no frame enters
     // and the frames under way skip their remaining steps.
     TaskErrors errors;
+    vision::CornerPixelCache corners;  // used by the first step alone, one frame at a time
     tbb::parallel_pipeline(
         static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()) + 1,
         tbb::make_filter<void, Token>(
@@ -134,7 +135,7 @@ struct HullStage {
             [&](tbb::flow_control& control) {
               const int i = next++;
               if (i >= count || errors.failed() ||
-                  !errors.Run([&] { Carve(silhouette_options, still, i, frames, has_evidence, all_empty); })) {
+                  !errors.Run([&] { Carve(silhouette_options, still, i, frames, has_evidence, all_empty, &corners); })) {
                 control.stop();
                 return Token{-1, false};
               }
@@ -159,9 +160,10 @@ struct HullStage {
   }
 
   // Frame i's evidence, has_evidence / all_empty, and its carving when it has evidence.
+  // `corners`: the distorted cameras' voxel corners, kept from frame to frame.
   void Carve(const vision::SilhouetteOptions& silhouette_options, const std::vector<vision::Silhouette>* still,
              int i, std::vector<FrameShapeInit>* frames, std::vector<bool>* has_evidence,
-             std::vector<bool>* all_empty) const {
+             std::vector<bool>* all_empty, vision::CornerPixelCache* corners) const {
     FrameShapeInit& frame = (*frames)[i];
     const Stopwatch start;
     std::vector<vision::Silhouette> silhouettes;
@@ -178,7 +180,7 @@ struct HullStage {
       return s.empty && s.source != vision::EvidenceSource::kMotion;
     });
     if (!(*has_evidence)[i]) return;
-    frame.carving = vision::CarveVoxels(cameras, silhouettes, dataset.bounds(), carving, frame.frame);
+    frame.carving = vision::CarveVoxels(cameras, silhouettes, dataset.bounds(), carving, frame.frame, corners);
     if (concavities.enabled && (concavities.every_frame || frame.frame == reference_frame))
       CarveFrameConcavities(&frame);
     frame.carve_seconds = start.Seconds();

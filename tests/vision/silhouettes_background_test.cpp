@@ -169,7 +169,9 @@ TEST(NoiseThreshold, FollowsEachCamerasNoise) {
                 IoU(fixed.mask, object), false_positive);
     EXPECT_GT(IoU(adaptive.mask, object), 0.97);
     EXPECT_LT(false_positive, 0.005);
-    if (camera == 0) EXPECT_LT(IoU(fixed.mask, object), 0.9);  // the histogram threshold fails here
+    if (camera == 0) {
+      EXPECT_LT(IoU(fixed.mask, object), 0.9);  // the histogram threshold fails here
+    }
   }
   EXPECT_GT(thresholds[1], 3 * thresholds[0]);  // the noisy camera's threshold is its own
 

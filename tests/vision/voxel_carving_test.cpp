@@ -255,6 +255,49 @@ TEST(VoxelCarving, DistortedCamerasProjectWithDistortion) {
   ExpectHullOfSphere(result, cameras, sphere, Tolerance(result));
 }
 
+// A distorted rig's voxel corners kept from frame to frame (CornerPixelCache): the same
+// occupancy as projected afresh, frame after frame, for two spheres (two frames); the
+// corners are projected once per camera, and not at all for a pinhole camera or past the
+// byte budget.
+TEST(VoxelCarving, KeptCornersOfDistortedCamerasCarveAsProjectedOnes) {
+  Eigen::VectorXd distortion(5);
+  distortion << -0.3, 0.05, 0.0, 0.0, 0.0;
+  std::vector<Camera> cameras;
+  const double directions[6][2] = {{20, 15}, {110, 15}, {200, 15}, {290, 15}, {60, 70}, {245, -50}};
+  for (int c = 0; c < 6; ++c)
+    cameras.push_back(LookAt("cam" + std::to_string(c), 160, 120, 200, Spherical(0.6, directions[c][0], directions[c][1]),
+                             Eigen::Vector3d(0.06, 0.0, -0.03), c == 5 ? Eigen::VectorXd() : distortion));
+  Sphere moved;
+  moved.centre += Eigen::Vector3d(0.03, -0.02, 0.01);
+  CornerPixelCache corners;
+  for (const Sphere& sphere : {Sphere(), moved}) {
+    const std::vector<Silhouette> silhouettes = SphereSilhouettes(cameras, sphere);
+    const CarvingResult afresh = CarveVoxels(cameras, silhouettes, kBounds, {});
+    const CarvingResult kept = CarveVoxels(cameras, silhouettes, kBounds, {}, 0, &corners);
+    ASSERT_EQ(kept.occupancy.size(), afresh.occupancy.size());
+    EXPECT_GT(afresh.carved_voxels, 1000u);
+    EXPECT_EQ(kept.carved_voxels, afresh.carved_voxels);
+    EXPECT_TRUE(std::equal(kept.occupancy.values.begin(), kept.occupancy.values.end(),
+                           afresh.occupancy.values.begin()));
+  }
+  const geometry::ScalarVolume grid = MakeVoxelGrid(kBounds, CarveVoxels(cameras, SphereSilhouettes(cameras, Sphere()),
+                                                                         kBounds, {}).resolution);
+  const GridCornerPixels* first = corners.Get(0, cameras[0], grid);
+  ASSERT_NE(first, nullptr);
+  EXPECT_EQ(corners.Get(0, cameras[0], grid), first) << "projected again";
+  EXPECT_EQ(corners.Get(5, cameras[5], grid), nullptr) << "a pinhole camera's corners are cheap";
+  const VoxelCornerProjector projector(cameras[0], grid);
+  for (const Eigen::Vector3i corner : {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(grid.nx, 3, grid.nz / 2),
+                                       Eigen::Vector3i(grid.nx / 2, grid.ny / 2, grid.nz)}) {
+    float u = 0, v = 0;
+    projector.ProjectCorner(corner.x(), corner.y(), corner.z(), &u, &v);
+    EXPECT_EQ(first->u[first->Index(corner.x(), corner.y(), corner.z())], u);
+    EXPECT_EQ(first->v[first->Index(corner.x(), corner.y(), corner.z())], v);
+  }
+  CornerPixelCache tiny(1000);
+  EXPECT_EQ(tiny.Get(0, cameras[0], grid), nullptr) << "past the budget";
+}
+
 TEST(VoxelCarving, BadCamerasAreExcludedWithAWarningAndTheRestIsCarved) {
   const Sphere sphere;
   std::vector<Camera> cameras = SixCameras();
