@@ -173,8 +173,9 @@ void NearestLentGains(const WindowGains& gains, int y, const float* own, float* 
     const int first = std::max(0, -offset.x), last = std::min(cols, cols - offset.x);
     for (int x = first; x < last; ++x) {  // branch-free: the compiler vectorizes it
       const int qx = x + offset.x;
-      const float gain = alpha[qx] + beta[qx] * u + gamma[qx] * v;  // NaN where no shadow window
-      const bool nearer = (gain == gain) & !(std::abs(gain - own[x]) >= std::abs(nearest[x] - own[x]));
+      const float gain = alpha[qx] + beta[qx] * u + gamma[qx] * v;
+      const bool window = alpha[qx] == alpha[qx];  // a shadow window (α not NaN)
+      const bool nearer = window & !(std::abs(gain - own[x]) >= std::abs(nearest[x] - own[x]));
       nearest[x] = nearer ? gain : nearest[x];
     }
   }

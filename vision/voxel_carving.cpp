@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
 #include "core/error.h"
@@ -62,8 +63,11 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
                   const std::vector<const GridCornerPixels*>& kept, const ScalarVolume& grid, double threshold,
                   float margin, int max_misses, std::vector<uint16_t>* hits, std::vector<uint16_t>* misses) {
   constexpr int kSlab = 4, kBlock = 8;
+  // The simple partitioner: slabs of at most kSlab planes, as the corner arrays below hold
+  // (the default partitioner may hand out larger ranges).
   tbb::parallel_for(tbb::blocked_range<int>(0, grid.nz, kSlab), [&](const tbb::blocked_range<int>& range) {
     const int k0 = range.begin(), k1 = range.end();
+    SUBFLOW_CHECK(k1 - k0 <= kSlab, "a slab thicker than the corner arrays");
     constexpr size_t kCorners = (kBlock + 1) * (kBlock + 1) * (kSlab + 1);
     float us[kCorners], vs[kCorners];
     for (std::size_t u = 0; u < used.size(); ++u) {
@@ -157,7 +161,7 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
               }
         }
     }
-  });
+  }, tbb::simple_partitioner());
 }
 
 std::string FrameLabel(int frame) { return "frame " + std::to_string(frame); }

@@ -205,7 +205,8 @@ geometry::ScalarVolume MakeVoxelGrid(const Bounds& bounds, int resolution);
 // one grid by one rig: a distorted camera's corner costs a Camera::Project (a pinhole
 // camera's a multiply-add, not kept), the same for every frame. Within a byte budget;
 // cameras past it are projected per frame. Kept values are ProjectCorner's, so a carving
-// is the same with the cache as without it.
+// is the same with the cache as without it. One rig: a camera index must name the same
+// camera in every call.
 class CornerPixelCache {
  public:
   explicit CornerPixelCache(std::size_t budget_bytes = std::size_t{256} << 20) : budget_(budget_bytes) {}

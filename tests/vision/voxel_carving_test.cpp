@@ -287,7 +287,7 @@ TEST(VoxelCarving, KeptCornersOfDistortedCamerasCarveAsProjectedOnes) {
   EXPECT_EQ(corners.Get(0, cameras[0], grid), first) << "projected again";
   EXPECT_EQ(corners.Get(5, cameras[5], grid), nullptr) << "a pinhole camera's corners are cheap";
   const VoxelCornerProjector projector(cameras[0], grid);
-  for (const Eigen::Vector3i corner : {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(grid.nx, 3, grid.nz / 2),
+  for (const Eigen::Vector3i& corner : {Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(grid.nx, 3, grid.nz / 2),
                                        Eigen::Vector3i(grid.nx / 2, grid.ny / 2, grid.nz)}) {
     float u = 0, v = 0;
     projector.ProjectCorner(corner.x(), corner.y(), corner.z(), &u, &v);
@@ -296,6 +296,21 @@ TEST(VoxelCarving, KeptCornersOfDistortedCamerasCarveAsProjectedOnes) {
   }
   CornerPixelCache tiny(1000);
   EXPECT_EQ(tiny.Get(0, cameras[0], grid), nullptr) << "past the budget";
+}
+
+// A grid of many planes carved on one thread: TBB's default partitioner hands such a loop
+// ranges of 8 planes or more, more than the support count's corner arrays hold (4); the
+// slabs must stay thin (an overflow of those arrays on the stack, before).
+TEST(VoxelCarving, AGridOfManyPlanesOnOneThreadIsCarvedInThinSlabs) {
+  const Sphere sphere;
+  const std::vector<Camera> cameras = SixCameras();
+  const Bounds tall{sphere.centre - Eigen::Vector3d(0.02, 0.02, 0.12), sphere.centre + Eigen::Vector3d(0.02, 0.02, 0.12)};
+  VoxelCarvingOptions options;
+  options.resolution = 512;
+  options.threads = 1;
+  const CarvingResult result = CarveVoxels(cameras, SphereSilhouettes(cameras, sphere), tall, options);
+  EXPECT_EQ(result.occupancy.nz, 512);
+  EXPECT_GT(result.carved_voxels, 0u);
 }
 
 TEST(VoxelCarving, BadCamerasAreExcludedWithAWarningAndTheRestIsCarved) {
