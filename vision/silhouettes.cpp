@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -18,15 +19,6 @@ void CheckRange(bool ok, const char* field, const std::string& expected, double 
                "expected " + expected + ", got " + std::to_string(value));
 }
 
-void FillHoles(cv::Mat* mask) {
-  // Background reachable from the image border stays background; the rest is a hole.
-  cv::Mat padded;
-  cv::copyMakeBorder(*mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  cv::floodFill(padded, cv::Point(0, 0), cv::Scalar(128));
-  const cv::Mat inner = padded(cv::Rect(1, 1, mask->cols, mask->rows));
-  mask->setTo(255, inner != 128);
-}
-
 void RemoveSmallRegions(cv::Mat* mask, int min_pixels) {
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(*mask, labels, stats, centroids, 8, CV_32S);
@@ -38,6 +30,53 @@ void RemoveSmallRegions(cv::Mat* mask, int min_pixels) {
     uint8_t* row = mask->ptr<uint8_t>(y);
     for (int x = 0; x < mask->cols; ++x)
       if (row[x] && !keep[label_row[x]]) row[x] = 0;
+  }
+}
+
+// The q-quantile of `values`' pixels under `where` (CV_8UC1), or -1 when there are none.
+double QuantileUnder(const cv::Mat& values, const cv::Mat& where, double q) {
+  std::vector<float> selected;
+  for (int y = 0; y < values.rows; ++y) {
+    const float* value = values.ptr<float>(y);
+    const uint8_t* in = where.ptr<uint8_t>(y);
+    for (int x = 0; x < values.cols; ++x)
+      if (in[x]) selected.push_back(value[x]);
+  }
+  if (selected.empty()) return -1.0;
+  const auto k = selected.begin() + static_cast<long>(q * static_cast<double>(selected.size() - 1));
+  std::nth_element(selected.begin(), k, selected.end());
+  return *k;
+}
+
+// Fills the holes of `mask` (background not reachable from the image border). With a
+// floor (> 0), a hole's region that is the background seen through a gap the object's
+// projection encloses (between crossed legs, an arm on the hip) stays open: a connected
+// region of at least `min_pixels` pixels whose measure is below the floor and, at its
+// median, no higher than the background around the object at its 75th percentile (or a
+// quarter of the floor). A dark part of the object whose measure stays under the floor (an
+// eye socket against a dark backdrop) has shading the backdrop does not have and is filled,
+// as is every region of fewer pixels (noise).
+void FillHoles(cv::Mat* mask, const cv::Mat& measure, double floor, int min_pixels) {
+  cv::Mat padded;
+  cv::copyMakeBorder(*mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::floodFill(padded, cv::Point(0, 0), cv::Scalar(128));
+  const cv::Mat reached = padded(cv::Rect(1, 1, mask->cols, mask->rows));
+  const cv::Mat holes = reached == 0;
+  mask->setTo(255, holes);
+  if (floor <= 0 || measure.empty() || cv::countNonZero(holes) == 0) return;
+  // A region's median at most the background's own level around the object, or a quarter
+  // of the floor where that is smaller (a noise-free render's 0, which the smoothing of the
+  // measure raises a little inside a narrow gap).
+  const double around = QuantileUnder(measure, reached == 128, 0.75);
+  if (around < 0) return;
+  const double open_level = std::max(around, 0.25 * floor);
+  cv::Mat candidates = holes & (measure < floor);
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(candidates, labels, stats, centroids, 8, CV_32S);
+  for (int label = 1; label < count; ++label) {
+    if (stats.at<int>(label, cv::CC_STAT_AREA) < std::max(1, min_pixels)) continue;
+    const cv::Mat region = labels == label;
+    if (QuantileUnder(measure, region, 0.5) <= open_level) mask->setTo(0, region);
   }
 }
 
@@ -237,7 +276,8 @@ void SetMask(const cv::Mat& mask, const SilhouetteOptions& options, Silhouette* 
 }  // namespace
 
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options, int open_radius, double close_floor) {
+                             const SilhouetteOptions& options, int open_radius, double close_floor,
+                             bool open_seen_through_holes) {
   SUBFLOW_CHECK(measure.type() == CV_32FC1, "ThresholdAndClean expects CV_32FC1");
   Silhouette silhouette;
   silhouette.measure = measure;
@@ -251,7 +291,8 @@ Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
     mask = closed;
   }
   if (options.min_region_pixels > 1) RemoveSmallRegions(&mask, options.min_region_pixels);
-  if (options.fill_holes) FillHoles(&mask);
+  if (options.fill_holes)
+    FillHoles(&mask, measure, open_seen_through_holes ? close_floor : 0.0, options.min_region_pixels);
   SetMask(mask, options, &silhouette);
   return silhouette;
 }
@@ -340,8 +381,18 @@ Silhouette SilhouetteFromDifference(const cv::Mat& image, const cv::Mat& backgro
                                                       : plain;
   if (!unknown.empty()) difference.setTo(1.0f, unknown);
   const cv::Mat measure = Smooth(difference, options.background_blur_sigma);
+  // A background of one colour is a plain backdrop (BackdropImage): a hole of its colour is
+  // the backdrop seen through. Behind a photographed room, parts of the object that match
+  // what lies behind them would open as well (bust_front_nomasks 0.97 → 2.02 mm).
+  std::vector<cv::Mat> channels;
+  cv::split(background, channels);
+  const bool one_colour = std::all_of(channels.begin(), channels.end(), [](const cv::Mat& channel) {
+    double low = 0.0, high = 0.0;
+    cv::minMaxLoc(channel, &low, &high);
+    return low == high;
+  });
   Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius,
-                                            options.background_close_floor * threshold);
+                                            options.background_close_floor * threshold, one_colour);
   silhouette.source = EvidenceSource::kBackground;
   if (options.background_contour_fraction > 0)
     SetMask(HalfContrastContour(measure, silhouette.mask, options.background_contour_fraction), options,

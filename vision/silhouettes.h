@@ -313,9 +313,13 @@ Silhouette SilhouetteFromEstimatedBackground(const cv::Mat& image, const Estimat
 // of radius open_radius, closing of radius options.close_radius (disks), regions under
 // options.min_region_pixels removed, holes filled (options.fill_holes); fills every
 // field of the returned Silhouette except `source`.
-// With close_floor > 0, the closing adds only pixels whose measure is ≥ close_floor.
+// With close_floor > 0, the closing adds only pixels whose measure is ≥ close_floor, and
+// with open_seen_through_holes the holes' regions that look like the background seen through
+// a gap the object encloses stay open (FillHoles in silhouettes.cpp): for a plain backdrop,
+// where such a region is the backdrop (docs/shape.md, "Holes the backdrop is seen through").
 Silhouette ThresholdAndClean(const cv::Mat& measure, double threshold,
-                             const SilhouetteOptions& options, int open_radius = 0, double close_floor = 0);
+                             const SilhouetteOptions& options, int open_radius = 0, double close_floor = 0,
+                             bool open_seen_through_holes = false);
 
 // The evidence camera `camera` of `dataset` takes for EvidenceSource::kAuto: masks if the
 // dataset has them, else the background image if background/<camera>.png exists, else

@@ -243,6 +243,53 @@ TEST(Silhouettes, BackgroundClosingJoinsDarkPartsButNotTheGapsBetweenLimbs) {
   EXPECT_EQ(cv::countNonZero(from_video.mask(cv::Rect(23, 38, 6, 3))), 18) << "the faint band was not joined";
 }
 
+// Two legs joined at the top and the bottom enclose a gap of the backdrop's colour: against
+// a plain backdrop (a background of one colour) the gap is the backdrop seen through and
+// stays open; a hole of the same size whose pixels are shaded just below the closing's
+// floor (a dark part of the object) and a hole of a few pixels are filled. Behind a
+// photographed background (not of one colour) every hole is filled, as before.
+TEST(Silhouettes, APlainBackdropSeenThroughAGapTheObjectEnclosesStaysOpen) {
+  const int width = 90, height = 90;
+  cv::Mat image(height, width, CV_32F, cv::Scalar(0.1f));
+  image(cv::Rect(15, 10, 60, 10)).setTo(0.6f);  // top bar
+  image(cv::Rect(15, 70, 60, 10)).setTo(0.6f);  // bottom bar
+  image(cv::Rect(15, 10, 10, 70)).setTo(0.6f);  // left leg
+  image(cv::Rect(65, 10, 10, 70)).setTo(0.6f);  // right leg
+  image(cv::Rect(45, 20, 10, 50)).setTo(0.6f);  // middle leg: two enclosed gaps
+  const cv::Rect gap(27, 24, 16, 42), shaded(57, 24, 6, 42), speck(33, 44, 2, 2);
+  // The right gap: the object's own dark part, shaded 0.0 … 0.02 above the backdrop (the
+  // floor is half the threshold of 0.06: 0.03).
+  for (int y = shaded.y; y < shaded.y + shaded.height; ++y)
+    for (int x = shaded.x; x < shaded.x + shaded.width; ++x)
+      image.at<float>(y, x) = 0.1f + 0.02f * static_cast<float>((x + y) % 3) / 2.0f + 0.005f;
+  cv::Mat image8, backdrop8;
+  image.convertTo(image8, CV_8U, 255.0);
+  cv::Mat(height, width, CV_32F, cv::Scalar(0.1f)).convertTo(backdrop8, CV_8U, 255.0);
+
+  SilhouetteOptions options;
+  options.background_threshold = 0.06;
+  options.background_shadow_test = false;
+  const Silhouette plain = SilhouetteFromBackground(image8, backdrop8, options);
+  EXPECT_EQ(cv::countNonZero(plain.mask(gap)), 0) << "the backdrop seen through the gap was filled";
+  EXPECT_EQ(cv::countNonZero(plain.mask(shaded)), shaded.area()) << "the object's dark part was opened";
+
+  // A speck of a few pixels is noise, filled like any small region.
+  cv::Mat specked = image.clone();
+  specked(gap).setTo(0.6f);
+  specked(speck).setTo(0.1f);
+  cv::Mat specked8;
+  specked.convertTo(specked8, CV_8U, 255.0);
+  EXPECT_EQ(cv::countNonZero(SilhouetteFromBackground(specked8, backdrop8, options).mask(speck)), speck.area());
+
+  // Behind a photographed room (a background not of one colour) a hole of what lies
+  // behind may be the object matching it: filled as before.
+  cv::Mat room = backdrop8.clone();
+  room(cv::Rect(0, 85, width, 5)).setTo(40);
+  cv::Mat in_room = image8.clone();
+  room(cv::Rect(0, 85, width, 5)).copyTo(in_room(cv::Rect(0, 85, width, 5)));
+  EXPECT_EQ(cv::countNonZero(SilhouetteFromBackground(in_room, room, options).mask(gap)), gap.area());
+}
+
 TEST(Silhouettes, OptionsAreChecked) {
   SilhouetteOptions options;
   EXPECT_NO_THROW(options.Check());
