@@ -79,8 +79,13 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
       const size_t stride = width + 1;
       const bool pinhole = !camera.HasDistortion();
       const VoxelCornerProjector projector(camera, grid);
-      // Bounding box of the projections of 8 corners (indices into us / vs); false when
-      // it is not inside the image or a corner is behind the camera (kInvalidPixel).
+      // Whether a box of pixel coordinates lies inside the image: false too when one of the
+      // corners it bounds is behind the camera (kInvalidPixel).
+      auto inside = [&](float x_min, float x_max, float y_min, float y_max) {
+        return x_min >= -0.5f && y_min >= -0.5f && x_max < width - 0.5f && y_max < height - 0.5f;
+      };
+      // Bounding box of the projections of 8 corners (indices into us / vs), and whether it
+      // is inside the image.
       auto footprint = [&](const size_t* corners, float* x_min, float* x_max, float* y_min, float* y_max) {
         *x_min = *x_max = us[corners[0]];
         *y_min = *y_max = vs[corners[0]];
@@ -90,7 +95,7 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
           *y_min = std::min(*y_min, vs[corners[c]]);
           *y_max = std::max(*y_max, vs[corners[c]]);
         }
-        return *x_min >= -0.5f && *y_min >= -0.5f && *x_max < width - 0.5f && *y_max < height - 0.5f;
+        return inside(*x_min, *x_max, *y_min, *y_max);
       };
       for (int j_begin = 0; j_begin < grid.ny; j_begin += kBlock)
         for (int i_begin = 0; i_begin < grid.nx; i_begin += kBlock) {
@@ -132,8 +137,7 @@ void CountSupport(const std::vector<Camera>& cameras, const std::vector<CarvingC
               }
             x_min = *std::min_element(us, us + c), x_max = *std::max_element(us, us + c);
             y_min = *std::min_element(vs, vs + c), y_max = *std::max_element(vs, vs + c);
-            const bool inside = x_min >= -0.5f && y_min >= -0.5f && x_max < width - 0.5f && y_max < height - 0.5f;
-            if (inside && whole_block(x_min, x_max, y_min, y_max)) continue;
+            if (inside(x_min, x_max, y_min, y_max) && whole_block(x_min, x_max, y_min, y_max)) continue;
           } else {
             projector.ProjectCorners(i_begin, i_end, j_begin, j_end, k0, k1, us, vs);
           }
