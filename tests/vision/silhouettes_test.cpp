@@ -257,7 +257,7 @@ TEST(Silhouettes, APlainBackdropSeenThroughAGapTheObjectEnclosesStaysOpen) {
   image(cv::Rect(65, 10, 10, 70)).setTo(0.6f);  // right leg
   image(cv::Rect(45, 20, 10, 50)).setTo(0.6f);  // middle leg: two enclosed gaps
   const cv::Rect gap(27, 24, 16, 42), shaded(57, 24, 6, 42), speck(33, 44, 2, 2);
-  // The right gap: the object's own dark part, shaded 0.0 … 0.02 above the backdrop (the
+  // The right gap: the object's own dark part, shaded 0.005 … 0.025 above the backdrop (the
   // floor is half the threshold of 0.06: 0.03).
   for (int y = shaded.y; y < shaded.y + shaded.height; ++y)
     for (int x = shaded.x; x < shaded.x + shaded.width; ++x)
