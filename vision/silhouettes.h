@@ -199,6 +199,8 @@ struct SilhouetteOptions {
   bool background_outlines = true;
   // Fill holes of the silhouette (background regions not connected to the image border).
   // Right for objects without through-holes; turn off for a torus seen through its hole.
+  // Against a plain backdrop (a background of one colour) the parts of a hole that look
+  // like the backdrop stay open all the same (ThresholdAndClean, open_seen_through_holes).
   bool fill_holes = true;
   // Connected object regions smaller than this many pixels are removed (noise). 0 = keep all.
   int min_region_pixels = 20;
