@@ -48,6 +48,19 @@ double QuantileUnder(const cv::Mat& values, const cv::Mat& where, double q) {
   return *k;
 }
 
+// Whether every pixel of `image` (CV_32F, any channels) equals its first: a plain backdrop.
+// A photographed background differs within its first pixels, so the scan stops there.
+bool OneColour(const cv::Mat& image) {
+  const int channels = image.channels();
+  const float* first = image.ptr<float>(0);
+  for (int y = 0; y < image.rows; ++y) {
+    const float* row = image.ptr<float>(y);
+    for (int i = 0; i < image.cols * channels; ++i)
+      if (row[i] != first[i % channels]) return false;
+  }
+  return true;
+}
+
 // Fills the holes of `mask` (background not reachable from the image border). With a
 // floor (> 0), a hole's region that is the background seen through a gap the object's
 // projection encloses (between crossed legs, an arm on the hip) stays open: a connected
@@ -73,11 +86,26 @@ void FillHoles(cv::Mat* mask, const cv::Mat& measure, double floor, int min_pixe
   cv::Mat candidates = holes & (measure < floor);
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(candidates, labels, stats, centroids, 8, CV_32S);
+  // Every large enough region's values in one pass over the image (row-major, as a scan of
+  // the region alone would take them), then its median.
+  std::vector<std::vector<float>> values(count);
+  const auto large = [&](int label) {
+    return label > 0 && stats.at<int>(label, cv::CC_STAT_AREA) >= std::max(1, min_pixels);
+  };
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x)
+      if (const int label = labels.at<int>(y, x); large(label)) values[label].push_back(measure.at<float>(y, x));
+  std::vector<uint8_t> open(count, 0);
   for (int label = 1; label < count; ++label) {
-    if (stats.at<int>(label, cv::CC_STAT_AREA) < std::max(1, min_pixels)) continue;
-    const cv::Mat region = labels == label;
-    if (QuantileUnder(measure, region, 0.5) <= open_level) mask->setTo(0, region);
+    if (values[label].empty()) continue;
+    std::vector<float>& v = values[label];
+    const auto median = v.begin() + static_cast<long>(0.5 * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), median, v.end());
+    open[label] = *median <= open_level;
   }
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x)
+      if (open[labels.at<int>(y, x)]) mask->at<uint8_t>(y, x) = 0;
 }
 
 cv::Mat Smooth(const cv::Mat& gray, double sigma) {
@@ -384,15 +412,8 @@ Silhouette SilhouetteFromDifference(const cv::Mat& image, const cv::Mat& backgro
   // A background of one colour is a plain backdrop (BackdropImage): a hole of its colour is
   // the backdrop seen through. Behind a photographed room, parts of the object that match
   // what lies behind them would open as well (bust_front_nomasks 0.97 → 2.02 mm).
-  std::vector<cv::Mat> channels;
-  cv::split(background, channels);
-  const bool one_colour = std::all_of(channels.begin(), channels.end(), [](const cv::Mat& channel) {
-    double low = 0.0, high = 0.0;
-    cv::minMaxLoc(channel, &low, &high);
-    return low == high;
-  });
   Silhouette silhouette = ThresholdAndClean(measure, threshold, options, options.background_open_radius,
-                                            options.background_close_floor * threshold, one_colour);
+                                            options.background_close_floor * threshold, OneColour(background));
   silhouette.source = EvidenceSource::kBackground;
   if (options.background_contour_fraction > 0)
     SetMask(HalfContrastContour(measure, silhouette.mask, options.background_contour_fraction), options,
