@@ -1,5 +1,6 @@
 #include "solver/observation/image_derivatives.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -76,24 +77,32 @@ SmoothedImage SmoothImage(const cv::Mat& image, double sigma) {
     ThrowError("image derivatives", "sigma", "expected a finite value ≥ 0 (pixels)");
   SmoothedImage result;
   result.intensity = Smooth(GrayFloat(image), sigma);
-  const cv::Mat kernel_x = (cv::Mat_<float>(1, 3) << -0.5f, 0.0f, 0.5f);
-  const cv::Mat kernel_y = (cv::Mat_<float>(3, 1) << -0.5f, 0.0f, 0.5f);
-  // filter2D correlates: out(x) = Σ k(i) in(x + i − 1) = (in(x + 1) − in(x − 1)) / 2.
-  cv::filter2D(result.intensity, result.gradient_x, CV_32F, kernel_x, cv::Point(-1, -1), 0.0,
-               cv::BORDER_REPLICATE);
-  cv::filter2D(result.intensity, result.gradient_y, CV_32F, kernel_y, cv::Point(-1, -1), 0.0,
-               cv::BORDER_REPLICATE);
   return result;
 }
 
 bool SampleImage(const SmoothedImage& image, const Eigen::Vector2d& pixel, double* intensity,
                  Eigen::Vector2d* gradient) {
+  const int width = image.width(), height = image.height();
   int x0 = 0, y0 = 0;
   double fx = 0.0, fy = 0.0;
-  if (!Footprint(image.width(), image.height(), pixel, &x0, &y0, &fx, &fy)) return false;
-  *intensity = Bilinear(image.intensity, x0, y0, fx, fy);
-  *gradient = Eigen::Vector2d(Bilinear(image.gradient_x, x0, y0, fx, fy),
-                              Bilinear(image.gradient_y, x0, y0, fx, fy));
+  if (!Footprint(width, height, pixel, &x0, &y0, &fx, &fy)) return false;
+  const cv::Mat& I = image.intensity;
+  *intensity = Bilinear(I, x0, y0, fx, fy);
+  // Central differences at the 2×2 corners, the border replicated; ½(b − a) in float is
+  // what filter2D's −½a + 0 + ½b rounds to (both products are exact).
+  const auto difference = [](float a, float b) { return 0.5f * (b - a); };
+  const int xm = std::max(x0 - 1, 0), xp = std::min(x0 + 2, width - 1);
+  const int ym = std::max(y0 - 1, 0), yp = std::min(y0 + 2, height - 1);
+  const float* r0 = I.ptr<float>(y0);
+  const float* r1 = I.ptr<float>(y0 + 1);
+  const float* rm = I.ptr<float>(ym);
+  const float* rp = I.ptr<float>(yp);
+  const double gx00 = difference(r0[xm], r0[x0 + 1]), gx10 = difference(r0[x0], r0[xp]);
+  const double gx01 = difference(r1[xm], r1[x0 + 1]), gx11 = difference(r1[x0], r1[xp]);
+  const double gy00 = difference(rm[x0], r1[x0]), gy10 = difference(rm[x0 + 1], r1[x0 + 1]);
+  const double gy01 = difference(r0[x0], rp[x0]), gy11 = difference(r0[x0 + 1], rp[x0 + 1]);
+  *gradient = Eigen::Vector2d((1.0 - fy) * ((1.0 - fx) * gx00 + fx * gx10) + fy * ((1.0 - fx) * gx01 + fx * gx11),
+                              (1.0 - fy) * ((1.0 - fx) * gy00 + fx * gy10) + fy * ((1.0 - fx) * gy01 + fx * gy11));
   return true;
 }
 

@@ -8,8 +8,11 @@
 //   replicated border); σ = 0 leaves the image as it is.
 //   Spatial gradient: central differences of the smoothed image,
 //     I_x(x, y) = (I(x + 1, y) − I(x − 1, y)) / 2,  I_y likewise  (intensity per pixel);
-//   its bilinear interpolation is what SampleImage returns, so intensity and gradient come
-//   from the same smoothed image.
+//   replicated at the border; its bilinear interpolation is what SampleImage returns, so
+//   intensity and gradient come from the same smoothed image. The differences are taken
+//   at sampling time from the intensities (a SmoothedImage holds one plane, not three: the
+//   refinement keeps a window's frames of every camera, docs/speed.md), in float as
+//   cv::filter2D with the kernel (−½, 0, ½) computes them, to the bit.
 //   Temporal derivative at frame f (intensity per frame):
 //     I_t = (I(f + 1) − I(f − 1)) / 2, one-sided I(f + 1) − I(f) or I(f) − I(f − 1) at
 //   the ends of the sequence. The motion solver itself uses the two-frame form of the same
@@ -23,9 +26,7 @@
 namespace subflow::solver {
 
 struct SmoothedImage {
-  cv::Mat intensity;   // CV_32FC1, smoothed
-  cv::Mat gradient_x;  // CV_32FC1, ∂I/∂x (per pixel)
-  cv::Mat gradient_y;  // CV_32FC1, ∂I/∂y
+  cv::Mat intensity;  // CV_32FC1, smoothed
 
   int width() const { return intensity.cols; }
   int height() const { return intensity.rows; }

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
 #include "solver/motion/constraint_collinearity.h"
@@ -125,6 +126,44 @@ TEST(SampleVisibility, OneTriangleAFaceDecidesAsAFinerTessellation) {
     }
   EXPECT_GT(visible, samples.size());
   EXPECT_LE(differ, 0.002 * visible) << differ << " of " << visible;
+}
+
+// The gradient SampleImage takes from the intensities at sampling time is, to the bit,
+// the bilinear interpolation of OpenCV's central-difference planes (cv::filter2D, kernel
+// (−½, 0, ½), replicated border), everywhere a sample is defined: inside and at the four
+// borders, on a random image.
+TEST(ImageDerivatives, GradientAtSamplingTimeIsFilter2DsPlanesToTheBit) {
+  cv::Mat image(160, 200, CV_32FC1);
+  cv::RNG rng(7);
+  rng.fill(image, cv::RNG::UNIFORM, 0.0, 1.0);
+  const SmoothedImage smoothed = SmoothImage(image, 0.8);
+  cv::Mat gx, gy;
+  const cv::Mat kx = (cv::Mat_<float>(1, 3) << -0.5f, 0.0f, 0.5f), ky = kx.t();
+  cv::filter2D(smoothed.intensity, gx, CV_32F, kx, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
+  cv::filter2D(smoothed.intensity, gy, CV_32F, ky, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
+  const auto bilinear = [](const cv::Mat& plane, double x, double y) {
+    const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+    const double fx = x - x0, fy = y - y0;
+    return (1.0 - fy) * ((1.0 - fx) * plane.at<float>(y0, x0) + fx * plane.at<float>(y0, x0 + 1)) +
+           fy * ((1.0 - fx) * plane.at<float>(y0 + 1, x0) + fx * plane.at<float>(y0 + 1, x0 + 1));
+  };
+  int sampled = 0, differing = 0;
+  for (double y = 0.0; y < image.rows - 1.0; y += 0.37) {
+    for (double x = 0.0; x < image.cols - 1.0; x += 0.41) {
+      double intensity = 0.0;
+      Eigen::Vector2d gradient;
+      if (!SampleImage(smoothed, Eigen::Vector2d(x, y), &intensity, &gradient)) continue;
+      ++sampled;
+      differing += gradient.x() != bilinear(gx, x, y) || gradient.y() != bilinear(gy, x, y);
+    }
+  }
+  EXPECT_GT(sampled, 4000);
+  EXPECT_EQ(differing, 0);
+  // A gradient that is not zero at the border: the replicated neighbour makes it one-sided.
+  double intensity = 0.0;
+  Eigen::Vector2d gradient;
+  ASSERT_TRUE(SampleImage(smoothed, Eigen::Vector2d(0.0, 0.0), &intensity, &gradient));
+  EXPECT_EQ(gradient.x(), 0.5f * (smoothed.intensity.at<float>(0, 1) - smoothed.intensity.at<float>(0, 0)));
 }
 
 // On a linear ramp I = a x + b y + c the smoothed gradient is exact (a Gaussian and a
