@@ -345,9 +345,34 @@ SignedDistanceImage ComputeSignedDistance(const cv::Mat& mask) {
       result.distance.at<float>(y, x) = mask.at<std::uint8_t>(y, x) > 0
                                             ? 0.5f - to_background.at<float>(y, x)
                                             : to_object.at<float>(y, x) - 0.5f;
-  cv::Sobel(result.distance, result.gradient_x, CV_32F, 1, 0, 3, 1.0 / 8.0, 0, cv::BORDER_REPLICATE);
-  cv::Sobel(result.distance, result.gradient_y, CV_32F, 0, 1, 3, 1.0 / 8.0, 0, cv::BORDER_REPLICATE);
   return result;
+}
+
+bool SampleSignedDistance(const SignedDistanceImage& image, const Eigen::Vector2d& pixel, double* distance,
+                          Eigen::Vector2d* gradient) {
+  const cv::Mat& d = image.distance;
+  double value = 0.0;
+  if (!SampleScalar(d, pixel, &value)) return false;
+  const int x0 = static_cast<int>(std::floor(pixel.x())), y0 = static_cast<int>(std::floor(pixel.y()));
+  const double fx = pixel.x() - x0, fy = pixel.y() - y0;
+  // Sobel as OpenCV separates it: a row pass, then a column pass, each in float; the
+  // smoothing taps are ¼ at the centre and ⅛ on the sum of the two sides (every product is
+  // exact, so fused or not, each pass rounds as cv::Sobel's does).
+  const auto sobel = [&](int x, int y) {
+    const int xm = std::max(x - 1, 0), xp = std::min(x + 1, d.cols - 1);
+    const int ym = std::max(y - 1, 0), yp = std::min(y + 1, d.rows - 1);
+    const float* rm = d.ptr<float>(ym);
+    const float* r0 = d.ptr<float>(y);
+    const float* rp = d.ptr<float>(yp);
+    const float gx = 0.25f * (r0[xp] - r0[xm]) + 0.125f * ((rm[xp] - rm[xm]) + (rp[xp] - rp[xm]));
+    const auto smooth = [&](const float* row) { return 0.25f * row[x] + 0.125f * (row[xm] + row[xp]); };
+    const float gy = smooth(rp) - smooth(rm);
+    return Eigen::Vector2d(gx, gy);
+  };
+  *gradient = (1.0 - fy) * ((1.0 - fx) * sobel(x0, y0) + fx * sobel(x0 + 1, y0)) +
+              fy * ((1.0 - fx) * sobel(x0, y0 + 1) + fx * sobel(x0 + 1, y0 + 1));
+  *distance = value;
+  return true;
 }
 
 SilhouetteCost::SilhouetteCost(const SignedDistanceImage* distance, const vision::Camera* camera,
@@ -376,14 +401,11 @@ bool SilhouetteCost::Evaluate(double const* const* parameters, double* residuals
   const Eigen::Vector3d X =
       SamplePosition(base_, stencil_.data(), support, basis_, dof_, parameters, 0);
   const Eigen::Vector2d pixel = camera_->ProjectUndistorted(X);
-  double value = 0.0, gx = 0.0, gy = 0.0;
-  const bool inside = SampleScalar(distance_->distance, pixel, &value) &&
-                      SampleScalar(distance_->gradient_x, pixel, &gx) &&
-                      SampleScalar(distance_->gradient_y, pixel, &gy);
-  if (!inside) {  // beyond the image border: no information, no force
-    value = 0.0;
-    gx = gy = 0.0;
-  }
+  double value = 0.0;
+  Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
+  // Beyond the image border: no information, no force.
+  if (!SampleSignedDistance(*distance_, pixel, &value, &gradient)) value = 0.0, gradient.setZero();
+  const double gx = gradient.x(), gy = gradient.y();
   const bool active = !one_sided_ || value > 0.0;
   residuals[0] = active ? weight_ * value : 0.0;
   if (!jacobians) return true;

@@ -155,15 +155,21 @@ class PatchCorrelationCost final : public ceres::CostFunction {
   bool reduced_ = false;
 };
 
-// Signed distance to a silhouette's outline, and its gradient, for SilhouetteCost.
+// Signed distance to a silhouette's outline, for SilhouetteCost.
 struct SignedDistanceImage {
-  cv::Mat distance;    // CV_32FC1, pixels, > 0 outside the silhouette, < 0 inside
-  cv::Mat gradient_x;  // CV_32FC1
-  cv::Mat gradient_y;  // CV_32FC1
+  cv::Mat distance;  // CV_32FC1, pixels, > 0 outside the silhouette, < 0 inside
 };
 // From a CV_8UC1 mask (nonzero = object). Throws subflow::Error on an empty or
 // non-8-bit mask.
 SignedDistanceImage ComputeSignedDistance(const cv::Mat& mask);
+
+// The bilinear distance at `pixel` and the bilinear interpolation of its gradient: the 3×3
+// Sobel derivatives / 8 (replicated border), taken at sampling time from the distance
+// plane, in float as cv::Sobel(…, 1 / 8.0, BORDER_REPLICATE) computes them, to the bit (the
+// refinement keeps a window's frames of every camera: one plane instead of three). False
+// (outputs untouched) when the 2×2 neighbourhood is not inside the image.
+bool SampleSignedDistance(const SignedDistanceImage& image, const Eigen::Vector2d& pixel, double* distance,
+                          Eigen::Vector2d* gradient);
 
 class SilhouetteCost final : public ceres::CostFunction {
  public:

@@ -312,6 +312,45 @@ TEST(SignedDistance, DiskOutlineIsWithinHalfAPixel) {
   EXPECT_THROW(ComputeSignedDistance(cv::Mat::zeros(4, 4, CV_32FC1)), Error);
 }
 
+// The gradient SampleSignedDistance takes from the distance plane at sampling time is, to
+// the bit, the bilinear interpolation of cv::Sobel's planes (3×3, / 8, replicated border),
+// everywhere a sample is defined: a disk's distance and random values, inside and at the
+// four borders, on an image wider than OpenCV's vector width and on a tiny one.
+TEST(SignedDistance, GradientAtSamplingTimeIsSobelsPlanesToTheBit) {
+  cv::Mat mask = cv::Mat::zeros(101, 121, CV_8UC1);
+  cv::circle(mask, {60, 50}, 30, cv::Scalar(255), cv::FILLED);
+  cv::Mat noise(5, 7, CV_32FC1);
+  cv::RNG rng(3);
+  rng.fill(noise, cv::RNG::UNIFORM, -40.0, 40.0);
+  for (const SignedDistanceImage& sdf : {ComputeSignedDistance(mask), SignedDistanceImage{noise}}) {
+    cv::Mat gx, gy;
+    cv::Sobel(sdf.distance, gx, CV_32F, 1, 0, 3, 1.0 / 8.0, 0, cv::BORDER_REPLICATE);
+    cv::Sobel(sdf.distance, gy, CV_32F, 0, 1, 3, 1.0 / 8.0, 0, cv::BORDER_REPLICATE);
+    const auto bilinear = [](const cv::Mat& plane, double x, double y) {
+      const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+      const double fx = x - x0, fy = y - y0;
+      return (1.0 - fy) * ((1.0 - fx) * plane.at<float>(y0, x0) + fx * plane.at<float>(y0, x0 + 1)) +
+             fy * ((1.0 - fx) * plane.at<float>(y0 + 1, x0) + fx * plane.at<float>(y0 + 1, x0 + 1));
+    };
+    int sampled = 0, differing = 0;
+    for (double y = 0.0; y <= sdf.distance.rows - 1.0; y += 0.23) {
+      for (double x = 0.0; x <= sdf.distance.cols - 1.0; x += 0.29) {
+        double value = 0.0;
+        Eigen::Vector2d gradient;
+        if (!SampleSignedDistance(sdf, Eigen::Vector2d(x, y), &value, &gradient)) continue;
+        ++sampled;
+        differing += value != bilinear(sdf.distance, x, y) || gradient.x() != bilinear(gx, x, y) ||
+                     gradient.y() != bilinear(gy, x, y);
+      }
+    }
+    EXPECT_GT(sampled, 250);
+    EXPECT_EQ(differing, 0) << sdf.distance.cols << "×" << sdf.distance.rows;
+  }
+  double value = 0.0;
+  Eigen::Vector2d gradient;
+  EXPECT_FALSE(SampleSignedDistance(ComputeSignedDistance(mask), Eigen::Vector2d(120.5, 3.0), &value, &gradient));
+}
+
 TEST(SilhouetteCost, PullsOutsidePointsAndMatchesNumericJacobian) {
   const vision::Camera camera = vision::LookAtCamera("c", 200, 160, 300.0, {0.0, 0.0, 1.0}, {0, 0, 0});
   cv::Mat mask = cv::Mat::zeros(160, 200, CV_8UC1);
