@@ -401,10 +401,9 @@ bool SilhouetteCost::Evaluate(double const* const* parameters, double* residuals
   const Eigen::Vector3d X =
       SamplePosition(base_, stencil_.data(), support, basis_, dof_, parameters, 0);
   const Eigen::Vector2d pixel = camera_->ProjectUndistorted(X);
-  double value = 0.0;
+  double value = 0.0;  // beyond the image border: no information, no force
   Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
-  // Beyond the image border: no information, no force.
-  if (!SampleSignedDistance(*distance_, pixel, &value, &gradient)) value = 0.0, gradient.setZero();
+  SampleSignedDistance(*distance_, pixel, &value, &gradient);
   const double gx = gradient.x(), gy = gradient.y();
   const bool active = !one_sided_ || value > 0.0;
   residuals[0] = active ? weight_ * value : 0.0;
