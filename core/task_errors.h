@@ -11,12 +11,17 @@
 // So no exception reaches TBB. Each task runs through TaskErrors::Run, which keeps what it
 // throws; the other tasks go on to their next progress point (where a stop request throws
 // for them too) or ask failed() to stop early; and once all have returned, the caller
-// rethrows the first exception kept. RunSideBySide does all of that for a parallel_invoke.
+// rethrows the first exception kept. RunSideBySide does all of that for a parallel_invoke,
+// and hands its TaskErrors to the tasks that take one: a chain of frames asks failed()
+// before each step, so a bad frame in one chain does not wait for the other chain's last
+// frame to be reported (whatever a stopped task leaves half done is never used: the
+// exception follows).
 #pragma once
 
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <type_traits>
 #include <utility>
 
 #include <tbb/parallel_invoke.h>
@@ -54,12 +59,20 @@ class TaskErrors {
 };
 
 // Runs the tasks side by side (tbb::parallel_invoke) and, once all have returned, rethrows
-// the first exception one of them threw. A task is never cut short by another's exception.
+// the first exception one of them threw. A task is never cut short by another's exception;
+// a task callable with a `const TaskErrors&` gets the group's, to stop early itself once
+// failed() says another task has thrown.
 template <typename... Tasks>
 void RunSideBySide(Tasks&&... tasks) {
   static_assert(sizeof...(Tasks) >= 2, "side by side takes two tasks or more");
   TaskErrors errors;
-  tbb::parallel_invoke([&] { errors.Run(tasks); }...);
+  const auto run = [&errors](auto& task) {
+    if constexpr (std::is_invocable_v<decltype(task), const TaskErrors&>)
+      errors.Run([&] { task(std::as_const(errors)); });
+    else
+      errors.Run(task);
+  };
+  tbb::parallel_invoke([&] { run(tasks); }...);
   errors.RethrowFirst();
 }
 

@@ -239,11 +239,12 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     return shift;
   };
   const std::vector<cv::Mat> reference_images = load(reference_frame);
-  // The chain from the reference frame to the last frame (direction +1) or to the first (-1).
-  auto chain = [&](int direction) {
+  // The chain from the reference frame to the last frame (+1) or the first (-1); see below.
+  auto chain = [&](int direction, const TaskErrors* group) {
     std::vector<cv::Mat> current = reference_images;
     int anchor = reference_frame;  // the last frame registered (or the reference)
     for (int f = reference_frame; f + direction >= 0 && f + direction < frame_count; f += direction) {
+      if (group && group->failed()) return;
       std::vector<cv::Mat> next = load(f + direction);
       const int to = f + direction;
       const Positions shift = propagate(f, to, current, next);
@@ -258,12 +259,12 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   // is computed as it would be alone (every parallel sum in the step has a fixed order):
   // side by side, one chain's serial parts (the solver's level loop, ray casts, decoding)
   // overlap the other's parallel ones. An exception in one (an interrupt, a bad frame) is
-  // rethrown here once the other has stopped too (core/task_errors.h).
+  // rethrown here once the other has stopped too, at its next frame (core/task_errors.h).
   if (options.concurrent_chains) {
-    RunSideBySide([&] { chain(+1); }, [&] { chain(-1); });
+    RunSideBySide([&](const TaskErrors& g) { chain(+1, &g); }, [&](const TaskErrors& g) { chain(-1, &g); });
   } else {
-    chain(+1);
-    chain(-1);
+    chain(+1, nullptr);
+    chain(-1, nullptr);
   }
   ProgressEnd(progress);
 

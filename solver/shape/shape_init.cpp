@@ -352,12 +352,15 @@ geometry::Positions FitEveryFrame(const ShapeInitOptions& options, ShapeFrameSto
   };
   ProgressBegin(progress, "fit subdivision surface", count);
   const std::vector<geometry::Positions> reference = fit(reference_index, result->base_mesh.V);
-  // The frames after the reference frame (direction +1) or before it (-1).
-  auto side = [&](int direction) {
+  // The frames after the reference frame (direction +1) or before it (-1); a side stops
+  // early once the other has thrown.
+  auto side = [&](int direction, const TaskErrors& group) {
     geometry::Positions base = reference.front();
-    for (int i = reference_index + direction; i >= 0 && i < count; i += direction) base = fit(i, base).front();
+    for (int i = reference_index + direction; i >= 0 && i < count && !group.failed(); i += direction)
+      base = fit(i, base).front();
   };
-  RunSideBySide([&] { side(+1); }, [&] { side(-1); });  // core/task_errors.h
+  RunSideBySide([&](const TaskErrors& group) { side(+1, group); },  // core/task_errors.h
+                [&](const TaskErrors& group) { side(-1, group); });
   ProgressEnd(progress);
   return reference.back();
 }

@@ -144,9 +144,10 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   // Per half: the largest displacement of every vertex (the halves write different frames).
   std::vector<std::vector<double>> moved(plan.halves.size(), std::vector<double>(hierarchy.VertexCount(level), 0.0));
   std::mutex progress_mutex;
+  // A chain of windows; beside the other half's (`group`), it stops early once that has thrown.
   auto run = [&](const WindowChain& chain, FrameImageCache* cache, std::vector<double>* chain_moved,
-                 ChainTally* tally) {
-    for (std::size_t w = 0; w < chain.windows.size(); ++w) {
+                 ChainTally* tally, const TaskErrors* group) {
+    for (std::size_t w = 0; w < chain.windows.size() && !(group && group->failed()); ++w) {
       const auto [first, last] = chain.windows[w];
       RefinementWindow window = OpenWindow(prepared, hierarchy, images.cameras, options, state->trajectory,
                                            state->result->control, cache, first, last, chain.span_first,
@@ -169,11 +170,12 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
     for (std::size_t i = 0; i < plan.halves.size(); ++i)
       caches[i]->ForgetVisibility();  // another level's samples, or another round
     if (plan.halves.size() == 1) {
-      run(plan.halves[0], caches[0], &moved[0], &tallies[0]);
+      run(plan.halves[0], caches[0], &moved[0], &tallies[0], nullptr);
     } else {
-      RunSideBySide([&] { run(plan.halves[0], caches[0], &moved[0], &tallies[0]); },  // core/task_errors.h
-                    [&] { run(plan.halves[1], caches[1], &moved[1], &tallies[1]); });
-      run(plan.seam, caches[0], &moved[0], &tallies[0]);
+      RunSideBySide(  // core/task_errors.h
+          [&](const TaskErrors& group) { run(plan.halves[0], caches[0], &moved[0], &tallies[0], &group); },
+          [&](const TaskErrors& group) { run(plan.halves[1], caches[1], &moved[1], &tallies[1], &group); });
+      run(plan.seam, caches[0], &moved[0], &tallies[0], nullptr);
     }
     report.parameters = report.residual_blocks = report.iterative_windows = 0;  // the last round's
     for (const ChainTally& tally : tallies) {

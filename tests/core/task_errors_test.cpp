@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "core/task_errors.h"
 
@@ -56,6 +57,33 @@ TEST(TaskErrors, TheFirstExceptionIsRethrownAndFailedTellsTheOthers) {
   EXPECT_TRUE(errors.failed());
   EXPECT_FALSE(errors.Run([] { throw std::out_of_range("second"); }));
   EXPECT_THROW(errors.RethrowFirst(), std::invalid_argument);
+}
+
+// A task that takes the group's TaskErrors sees another task's exception and stops early;
+// the caller still gets that exception. Needs two threads: on one, the tasks run one after
+// the other and the throwing one may come second.
+TEST(TaskErrors, ATaskThatTakesTheGroupStopsOnceAnotherHasThrown) {
+  if (tbb::this_task_arena::max_concurrency() < 2) GTEST_SKIP() << "needs two threads; TBB has one here";
+  std::atomic<bool> thrown{false};
+  bool stopped_early = false;
+  try {
+    RunSideBySide(
+        [&] {
+          thrown.store(true);
+          throw std::runtime_error("bad frame");
+        },
+        [&](const TaskErrors& group) {
+          AwaitFlag(thrown);
+          const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+          while (!group.failed() && std::chrono::steady_clock::now() < deadline)
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+          stopped_early = group.failed();
+        });
+    ADD_FAILURE() << "the exception did not reach the caller";
+  } catch (const std::runtime_error& error) {
+    EXPECT_STREQ(error.what(), "bad frame");
+  }
+  EXPECT_TRUE(stopped_early) << "the task never saw the other's exception";
 }
 
 TEST(TaskErrors, TasksThatDoNotThrowAllRun) {
