@@ -404,12 +404,11 @@ bool SilhouetteCost::Evaluate(double const* const* parameters, double* residuals
   double value = 0.0;  // beyond the image border: no information, no force
   Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
   SampleSignedDistance(*distance_, pixel, &value, &gradient);
-  const double gx = gradient.x(), gy = gradient.y();
   const bool active = !one_sided_ || value > 0.0;
   residuals[0] = active ? weight_ * value : 0.0;
   if (!jacobians) return true;
   const Eigen::RowVector3d g =
-      active ? Eigen::RowVector3d(weight_ * Eigen::RowVector2d(gx, gy) * camera_->ProjectionJacobian(X))
+      active ? Eigen::RowVector3d(weight_ * gradient.transpose() * camera_->ProjectionJacobian(X))
              : Eigen::RowVector3d::Zero();
   for (int j = 0; j < support; ++j) {
     if (!jacobians[j]) continue;

@@ -141,11 +141,10 @@ TEST(ImageDerivatives, GradientAtSamplingTimeIsFilter2DsPlanesToTheBit) {
   const cv::Mat kx = (cv::Mat_<float>(1, 3) << -0.5f, 0.0f, 0.5f), ky = kx.t();
   cv::filter2D(smoothed.intensity, gx, CV_32F, kx, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
   cv::filter2D(smoothed.intensity, gy, CV_32F, ky, cv::Point(-1, -1), 0.0, cv::BORDER_REPLICATE);
-  const auto bilinear = [](const cv::Mat& plane, double x, double y) {
-    const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-    const double fx = x - x0, fy = y - y0;
-    return (1.0 - fy) * ((1.0 - fx) * plane.at<float>(y0, x0) + fx * plane.at<float>(y0, x0 + 1)) +
-           fy * ((1.0 - fx) * plane.at<float>(y0 + 1, x0) + fx * plane.at<float>(y0 + 1, x0 + 1));
+  const auto bilinear = [](const cv::Mat& plane, double x, double y) {  // as the planes were sampled
+    double value = 0.0;
+    EXPECT_TRUE(SampleScalar(plane, Eigen::Vector2d(x, y), &value));
+    return value;
   };
   int sampled = 0, differing = 0;
   for (double y = 0.0; y < image.rows - 1.0; y += 0.37) {
