@@ -28,7 +28,7 @@ double SampleClamped(const SmoothedImage& image, const Eigen::Vector2d& pixel,
 
 // X = X⁰ + Σ_j w_j B_j e_j for one sample (row `k` of the stencil).
 Eigen::Vector3d SamplePosition(const Eigen::Vector3d& base, const double* weights, int support,
-                               const std::vector<Eigen::Matrix3d>& basis, int dof,
+                               const SupportBases& basis, int dof,
                                double const* const* parameters, int first_block) {
   Eigen::Vector3d X = base;
   for (int j = 0; j < support; ++j) {
@@ -146,7 +146,8 @@ PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, std::vector<Pat
   const auto support = static_cast<std::size_t>(stencil_.cols());
   const auto m = static_cast<std::size_t>(stencil_.rows());
   for (const PatchView& view : views_) {
-    if (!view.image || !view.camera || view.base.size() != m || view.basis.size() != support)
+    if (!view.image || !view.camera || !view.base.all || !view.basis.all || view.base.size() != m ||
+        view.basis.size() != support)
       ThrowError("PatchCorrelationCost", "view",
                  "needs an image, a camera, one position per sample and one basis per support "
                  "vertex, with its blocks inside the block count");
@@ -377,17 +378,17 @@ bool SampleSignedDistance(const SignedDistanceImage& image, const Eigen::Vector2
 
 SilhouetteCost::SilhouetteCost(const SignedDistanceImage* distance, const vision::Camera* camera,
                                Eigen::Vector3d base, Eigen::VectorXd stencil,
-                               std::vector<Eigen::Matrix3d> basis, int dof, double weight,
+                               SupportBases basis, int dof, double weight,
                                bool one_sided)
     : distance_(distance),
       camera_(camera),
       base_(std::move(base)),
       stencil_(std::move(stencil)),
-      basis_(std::move(basis)),
+      basis_(basis),
       dof_(dof),
       weight_(weight),
       one_sided_(one_sided) {
-  if (!distance_ || !camera_ || stencil_.size() != static_cast<Eigen::Index>(basis_.size()) ||
+  if (!distance_ || !camera_ || !basis_.all || stencil_.size() != static_cast<Eigen::Index>(basis_.size()) ||
       (dof != 1 && dof != 3))
     ThrowError("SilhouetteCost", "arguments",
                "needs a distance image, a camera, one basis per stencil weight and dof 1 or 3");

@@ -36,10 +36,31 @@
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
 
+#include "geometry/triangle_mesh.h"
 #include "solver/observation/image_derivatives.h"
 #include "vision/camera.h"
 
 namespace subflow::solver {
+
+// Where a block reads its samples' positions X⁰ and its support vertices' bases B_j: in
+// place, in the frame's arrays that the refinement window keeps for the whole solve
+// (refinement_window.h: FrameState), not as copies per block. Views and silhouette blocks
+// are made per patch, camera and frame, so copies were hundreds of MB on an HD take
+// (docs/speed.md). The arrays must outlive the cost functions that read them.
+struct SamplePositions {
+  const geometry::Positions* all = nullptr;  // one row per sample of the level
+  int first = 0, count = 0;                  // the patch's samples: rows [first, first + count)
+  std::size_t size() const { return static_cast<std::size_t>(count); }
+  Eigen::Vector3d operator[](std::size_t k) const {
+    return all->row(first + static_cast<Eigen::Index>(k)).transpose();
+  }
+};
+struct SupportBases {
+  const std::vector<Eigen::Matrix3d>* all = nullptr;  // B_v per vertex of the level
+  const std::vector<int>* support = nullptr;          // the patch's support vertices
+  std::size_t size() const { return support ? support->size() : 0; }
+  const Eigen::Matrix3d& operator[](std::size_t j) const { return (*all)[(*support)[j]]; }
+};
 
 // The samples of one patch in one view: image, camera, and per sample its current
 // position X⁰ (rows), all at one frame. `first_block` is the index, among the cost's
@@ -48,9 +69,9 @@ namespace subflow::solver {
 struct PatchView {
   const SmoothedImage* image = nullptr;
   const vision::Camera* camera = nullptr;
-  std::vector<Eigen::Vector3d> base;  // X⁰ per sample (size m)
+  SamplePositions base;  // X⁰ per sample (size m)
   // B_j per support vertex (3×dof each, column-major dof columns).
-  std::vector<Eigen::Matrix3d> basis;
+  SupportBases basis;
   int first_block = 0;
 };
 
@@ -175,7 +196,7 @@ class SilhouetteCost final : public ceres::CostFunction {
  public:
   // One sample: X⁰, stencil weights on `basis.size()` support blocks of size dof.
   SilhouetteCost(const SignedDistanceImage* distance, const vision::Camera* camera,
-                 Eigen::Vector3d base, Eigen::VectorXd stencil, std::vector<Eigen::Matrix3d> basis,
+                 Eigen::Vector3d base, Eigen::VectorXd stencil, SupportBases basis,
                  int dof, double weight, bool one_sided);
 
   bool Evaluate(double const* const* parameters, double* residuals,
@@ -186,7 +207,7 @@ class SilhouetteCost final : public ceres::CostFunction {
   const vision::Camera* camera_;
   Eigen::Vector3d base_;
   Eigen::VectorXd stencil_;
-  std::vector<Eigen::Matrix3d> basis_;
+  SupportBases basis_;
   int dof_;
   double weight_;
   bool one_sided_;

@@ -17,11 +17,9 @@ void AppendBlocks(RefinementWindow& window, int frame, const std::vector<int>& s
   for (int v : support) blocks->push_back(window.Increment(frame, v));
 }
 
-std::vector<Eigen::Matrix3d> BasesOf(const RefinementWindow& window, int frame, const std::vector<int>& support) {
-  std::vector<Eigen::Matrix3d> basis;
-  basis.reserve(support.size());
-  for (int v : support) basis.push_back(window.states.at(frame).basis[v]);
-  return basis;
+// The bases of `support` at `frame`, read in place (ncc_cost.h: SupportBases).
+SupportBases BasesOf(const RefinementWindow& window, int frame, const std::vector<int>& support) {
+  return {&window.states.at(frame).basis, &support};
 }
 
 // The rows (samples of `face`) usable in every given (frame, camera) view.
@@ -42,7 +40,7 @@ PatchView MakeView(RefinementWindow& window, int frame, int camera, int face, in
   PatchView view;
   view.image = &window.images->Gray(frame)[camera];
   view.camera = &(*window.cameras)[camera];
-  for (int s = 0; s < m; ++s) view.base.push_back(window.states.at(frame).positions.row(first + s).transpose());
+  view.base = {&window.states.at(frame).positions, first, m};
   view.basis = BasesOf(window, frame, window.sampling->support[face]);
   view.first_block = first_block;
   return view;

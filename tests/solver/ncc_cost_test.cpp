@@ -36,8 +36,9 @@ struct Fixture {
   SmoothedImage image_a, image_b;
   PatchStencil stencil;
   std::vector<Eigen::Matrix3d> basis;
-  std::vector<Eigen::Vector3d> base;
-  std::vector<double> parameters;  // 3 blocks × dof
+  std::vector<int> support = {0, 1, 2};  // the views read basis[support[j]]
+  geometry::Positions base;              // X⁰, one row per sample
+  std::vector<double> parameters;        // 3 blocks × dof
 
   explicit Fixture(int dof, bool linear_images = false) {
     image_a = SmoothImage(SmoothPattern(200, 160, linear_images), 1.0);
@@ -46,22 +47,23 @@ struct Fixture {
                             : SmoothImage(SmoothPattern(200, 160, false) * 0.7 + 0.1, 1.0);
     std::mt19937 random(7);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    const int m = 9, support = 3;
-    stencil.resize(m, support);
+    const int m = 9, vertices = 3;
+    stencil.resize(m, vertices);
+    base.resize(m, 3);
     for (int k = 0; k < m; ++k) {
-      for (int j = 0; j < support; ++j) stencil(k, j) = uniform(random);
+      for (int j = 0; j < vertices; ++j) stencil(k, j) = uniform(random);
       stencil.row(k) /= stencil.row(k).sum();
-      base.emplace_back(0.01 * (k % 3) - 0.01, 0.01 * (k / 3) - 0.01, 0.002 * k);
+      base.row(k) << 0.01 * (k % 3) - 0.01, 0.01 * (k / 3) - 0.01, 0.002 * k;
     }
-    for (int j = 0; j < support; ++j) {
+    for (int j = 0; j < vertices; ++j) {
       Eigen::Matrix3d B = Eigen::Matrix3d::Random();
       basis.push_back(Eigen::HouseholderQR<Eigen::Matrix3d>(B).householderQ());
     }
-    parameters.resize(static_cast<std::size_t>(support) * dof);
+    parameters.resize(static_cast<std::size_t>(vertices) * dof);
     for (double& p : parameters) p = 0.002 * (uniform(random) - 0.5);
   }
   PatchView View(const vision::Camera& camera, const SmoothedImage& image, int first_block) const {
-    return PatchView{&image, &camera, base, basis, first_block};
+    return PatchView{&image, &camera, {&base, 0, static_cast<int>(base.rows())}, {&basis, &support}, first_block};
   }
 };
 
@@ -279,7 +281,7 @@ TEST(PatchCorrelationCost, ReducedFormKeepsTheNormalEquationsAndTheCost) {
 TEST(PatchCorrelationCost, RejectsInconsistentViews) {
   const Fixture fixture(3);
   PatchView short_view = fixture.View(fixture.camera_a, fixture.image_a, 0);
-  short_view.base.pop_back();
+  short_view.base.count -= 1;
   EXPECT_THROW(PatchCorrelationCost(fixture.stencil, short_view,
                                     fixture.View(fixture.camera_b, fixture.image_b, 0), 3, 3, 1.0, 0.0),
                Error);
@@ -357,7 +359,9 @@ TEST(SilhouetteCost, PullsOutsidePointsAndMatchesNumericJacobian) {
   const SignedDistanceImage sdf = ComputeSignedDistance(mask);
   // A point projecting ~10 px right of the disk's outline.
   const Eigen::Vector3d outside(0.135, 0.0, 0.0);
-  std::vector<Eigen::Matrix3d> basis(2, Eigen::Matrix3d::Identity());
+  const std::vector<Eigen::Matrix3d> bases(2, Eigen::Matrix3d::Identity());
+  const std::vector<int> support = {1, 0};
+  const SupportBases basis{&bases, &support};
   const Eigen::VectorXd stencil = Eigen::Vector2d(0.7, 0.3);
   const SilhouetteCost one_sided(&sdf, &camera, outside, stencil, basis, 3, 0.5, true);
   std::vector<double> e(6, 0.0);
