@@ -259,6 +259,7 @@ nlohmann::json RefinementJson(const solver::StereoRefinementOptions& o, const so
     levels.push_back({{"level", l.level}, {"dof", l.dof}, {"patches", l.patches},
                       {"active_patches", l.active_patches}, {"active_fraction", l.active_fraction},
                       {"windows", l.windows}, {"iterative_windows", l.iterative_windows},
+                      {"concurrent_halves", l.concurrent_halves},
                       {"parameters", l.parameters}, {"residual_blocks", l.residual_blocks},
                       {"mean_increment", l.mean_increment}, {"iterations", l.iterations},
                       {"seconds", l.seconds}, {"solver_seconds", l.solver_seconds}});

@@ -1,6 +1,7 @@
 #include "solver/stereo/stereo_refinement.h"
 
 #include <algorithm>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -43,9 +44,9 @@ struct WindowChain {
   std::vector<std::pair<int, int>> windows;
 };
 
-// A level's windows: one chain over the take; or, with concurrent_halves on a take of at
-// least 3 windows, the two halves' chains side by side (neither reads a frame of the
-// other), then one window across the seam whose context is both halves' refined frames.
+// A level's windows: one chain over the take; or, with `halves` on a take of at least 3
+// windows, the two halves' chains side by side (neither reads a frame of the other), then
+// one window across the seam whose context is both halves' refined frames.
 struct WindowPlan {
   std::vector<WindowChain> halves;
   WindowChain seam;  // no window without halves
@@ -57,14 +58,14 @@ struct WindowPlan {
   }
 };
 
-WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options) {
+WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options, bool halves) {
   auto chain = [&](int first, int last) {
     WindowChain result{first, last, Windows(last - first + 1, options.window, options.window_overlap)};
     for (auto& [w0, w1] : result.windows) w0 += first, w1 += first;
     return result;
   };
   WindowPlan plan;
-  if (!options.concurrent_halves || frames < 3 * options.window) {
+  if (!halves || frames < 3 * options.window) {
     plan.halves.push_back(chain(0, frames - 1));
     return plan;
   }
@@ -72,6 +73,22 @@ WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options) {
   plan.halves = {chain(0, middle - 1), chain(middle, frames - 1)};
   plan.seam = {0, frames - 1, {{first, first + options.window - 1}}};
   return plan;
+}
+
+// Whether the windows of `level` run as two halves side by side (concurrent_halves): kAuto
+// when a window of the level (its frames × the active patches' corners × dof unknowns)
+// goes to the iterative solver, whose products run on one thread.
+bool SideBySide(const StereoRefinementOptions& options, const LoopHierarchy& hierarchy, const RefinementLevel& level,
+                int frames) {
+  if (options.concurrent_halves != ConcurrentHalves::kAuto) return options.concurrent_halves == ConcurrentHalves::kOn;
+  const geometry::Faces& F = hierarchy.LevelFaces(level.level);
+  std::vector<char> corner(hierarchy.VertexCount(level.level), 0);
+  for (int f = 0; f < F.rows(); ++f)
+    if (level.active_faces[f])
+      for (int c = 0; c < 3; ++c) corner[F(f, c)] = 1;
+  const long vertices = std::count(corner.begin(), corner.end(), 1);
+  const long unknowns = vertices * level.dof * std::min(options.window, frames);
+  return options.solver.Iterative(static_cast<int>(std::min<long>(unknowns, std::numeric_limits<int>::max())));
 }
 
 // The refinement state of the whole sequence, which the windows' solutions move.
@@ -139,8 +156,10 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   report.patches = hierarchy.FaceCount(level);
   report.active_patches = static_cast<int>(std::count(prepared.active_faces.begin(), prepared.active_faces.end(), 1));
   report.active_fraction = static_cast<double>(report.active_patches) / report.patches;
-  const WindowPlan plan = PlanWindows(static_cast<int>(state->result->control.size()), options);
+  const int frames = static_cast<int>(state->result->control.size());
+  const WindowPlan plan = PlanWindows(frames, options, SideBySide(options, hierarchy, prepared, frames));
   report.windows = static_cast<int>(plan.Count());
+  report.concurrent_halves = plan.halves.size() > 1;
   // Per half: the largest displacement of every vertex (the halves write different frames).
   std::vector<std::vector<double>> moved(plan.halves.size(), std::vector<double>(hierarchy.VertexCount(level), 0.0));
   std::mutex progress_mutex;
@@ -199,15 +218,30 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   report.mean_increment = moved_sum / static_cast<double>(moved_vertices.size());
   report.seconds = start.Seconds();
   spdlog::info("refinement level {}: {} of {} patches, dof {}, {} unknowns, {} residual blocks, "
-               "{} iterations, mean max |increment| {:.3g}, {:.1f} s ({:.1f} s in Ceres)",
+               "{} iterations, mean max |increment| {:.3g}, {:.1f} s ({:.1f} s in Ceres){}",
                level, report.active_patches, report.patches, report.dof, report.parameters,
                report.residual_blocks, report.iterations, report.mean_increment, report.seconds,
-               report.solver_seconds);
+               report.solver_seconds, report.concurrent_halves ? ", two halves side by side" : "");
   state->result->levels.push_back(report);
   return moved_vertices;
 }
 
 }  // namespace
+
+std::string ToString(ConcurrentHalves mode) {
+  switch (mode) {
+    case ConcurrentHalves::kOff: return "off";
+    case ConcurrentHalves::kAuto: return "auto";
+    case ConcurrentHalves::kOn: return "on";
+  }
+  return "?";
+}
+
+ConcurrentHalves ParseConcurrentHalves(const std::string& text, const std::string& field) {
+  for (ConcurrentHalves mode : {ConcurrentHalves::kOff, ConcurrentHalves::kAuto, ConcurrentHalves::kOn})
+    if (ToString(mode) == text) return mode;
+  ThrowError("stereo refinement options", field, "'" + text + "' is not one of off, auto, on");
+}
 
 std::string RefinementResult::BriefReport() const {
   std::string level_list;
@@ -333,7 +367,10 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
   FrameImageCache first_half(images, options.image_sigma), second_half(images, options.image_sigma);
   FrameImageCache* const caches[2] = {&first_half, &second_half};
 
-  const std::size_t windows = PlanWindows(static_cast<int>(control.size()), options).Count();
+  // Progress counts windows; a level side by side has one more (the seam's) or as many.
+  const int frames = static_cast<int>(control.size());
+  const std::size_t windows =
+      std::max(PlanWindows(frames, options, false).Count(), PlanWindows(frames, options, true).Count());
   ProgressBegin(progress, "refinement",
                 static_cast<std::size_t>(finest_refined - options.coarsest_level + 1) * options.rounds * windows);
   std::size_t done = 0;
@@ -341,6 +378,8 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
   for (int level = options.coarsest_level; level <= finest_refined; ++level) {
     const std::vector<char> moved = RefineLevel(images, hierarchy, bounds, options, level, active, caches, &state,
                                                 progress, &done);
+    done = static_cast<std::size_t>(level - options.coarsest_level + 1) * options.rounds * windows;
+    ProgressUpdate(progress, done);
     if (level == finest_refined) break;
     // Adaptivity: a child face is refined when its parent was and one of the parent's
     // corners moved by more than the threshold at this level (details not small), and,

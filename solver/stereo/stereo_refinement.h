@@ -49,6 +49,7 @@
 //   stereo_refinement.cpp      levels, windows, adaptivity, applying the increments
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <ceres/solver.h>
@@ -61,6 +62,12 @@
 #include "vision/working_volume.h"
 
 namespace subflow::solver {
+
+// Whether a level's windows run as two halves side by side (StereoRefinementOptions).
+enum class ConcurrentHalves { kOff, kAuto, kOn };
+std::string ToString(ConcurrentHalves mode);  // "off", "auto", "on"
+// The mode named `text` ("off", "auto", "on"); throws subflow::Error naming `field`.
+ConcurrentHalves ParseConcurrentHalves(const std::string& text, const std::string& field);
 
 // The Ceres settings of each window's solve.
 struct WindowSolverOptions {
@@ -143,11 +150,14 @@ struct StereoRefinementOptions {
   // as now, 0 → 0.0637 / 0.509, 2 → 0.0580 / 0.510.
   int window_overlap = 2;
   // Takes of at least 3 windows' frames refined as two halves side by side, each window
-  // by window, then a window across the seam with both halves as its context (Ceres 2.1's
-  // iterative solver multiplies by the Jacobian on one thread: one half's solve fills the
-  // core the other's leaves idle). Off by default: on pose2sim frames 40–63 it took 102 s
-  // against 118 s but raised the peak memory from 2.4 to 3.8 GB (docs/speed.md).
-  bool concurrent_halves = false;
+  // by window, then a window across the seam with both halves as its context. Ceres 2.1's
+  // iterative solver multiplies by the Jacobian on one thread, so while one half's window
+  // is in its linear solve the other core is free for the other half's; the sparse
+  // Cholesky of the small windows already uses both cores (OpenBLAS). kAuto: side by side
+  // at the levels whose windows are solved iteratively (solver.Iterative of the level's
+  // unknowns per window). pose2sim, whole take: refinement 416 → 337 s, mean NCC after
+  // 0.6173 → 0.6203; the blob's windows are all direct: unchanged (docs/speed.md).
+  ConcurrentHalves concurrent_halves = ConcurrentHalves::kAuto;
   // Visibility/sample updates per level (visibility is recomputed at every level anyway).
   int rounds = 1;
   WindowSolverOptions solver;
@@ -211,6 +221,7 @@ struct RefinementLevelReport {
   double solver_seconds = 0;   // inside ceres::Solve
   int iterations = 0;          // Ceres iterations over all windows and rounds
   int iterative_windows = 0;   // windows solved by solver.iterative_solver (last round)
+  bool concurrent_halves = false;  // the windows ran as two halves side by side
 };
 
 struct RefinementFrameReport {

@@ -142,7 +142,7 @@ std::map<std::string, Case> Cases(const Inputs& in) {
                  {"--concavities", ""},
                  {"--motion-smoothness", "0.0041"}, {"--motion-highpass", "1.2"}, {"--refine-from", "1"},
                  {"--refine-to", "1"}, {"--window", "4"}, {"--window-overlap", "1"}, {"--rounds", "2"},
-                 {"--concurrent-halves", ""},
+                 {"--concurrent-halves", "on"},
                  {"--iterations", "3"}, {"--linear-solver", "DENSE_QR"}, {"--threads", "1"},
                  {"--iterative-from-unknowns", "100"}, {"--iterative-solver", "DENSE_QR"},
                  {"--samples-per-pixel", "0.5"}, {"--max-cameras", "4"}, {"--temporal-weight", "0.5"},

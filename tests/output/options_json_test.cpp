@@ -125,5 +125,21 @@ TEST(OptionsJson, AnOlderFileWithoutTheBackdropTakesItsDefaults) {
   EXPECT_TRUE(older.shape.still.backdrop.enabled);
 }
 
+// concurrent_halves was a bool before it had an automatic mode: an older file's true / false
+// reads as "on" / "off" (what those runs did), the mode's names round-trip, others fail.
+TEST(OptionsJson, ConcurrentHalvesReadsTheOlderBoolAndTheModesNames) {
+  nlohmann::json json = solver::ReconstructionOptions();
+  EXPECT_EQ(json.at("refinement").at("concurrent_halves"), "auto");
+  EXPECT_EQ(json.get<solver::ReconstructionOptions>().refinement.concurrent_halves, solver::ConcurrentHalves::kAuto);
+  json["refinement"]["concurrent_halves"] = true;
+  EXPECT_EQ(json.get<solver::ReconstructionOptions>().refinement.concurrent_halves, solver::ConcurrentHalves::kOn);
+  json["refinement"]["concurrent_halves"] = false;
+  EXPECT_EQ(json.get<solver::ReconstructionOptions>().refinement.concurrent_halves, solver::ConcurrentHalves::kOff);
+  json["refinement"]["concurrent_halves"] = "on";
+  EXPECT_EQ(json.get<solver::ReconstructionOptions>().refinement.concurrent_halves, solver::ConcurrentHalves::kOn);
+  json["refinement"]["concurrent_halves"] = "sometimes";
+  EXPECT_THROW(json.get<solver::ReconstructionOptions>(), Error);
+}
+
 }  // namespace
 }  // namespace subflow::output

@@ -204,18 +204,42 @@ TEST(StereoRefinement, HalvesSideBySideRefineEveryFrameAsOneChainDoes) {
   const Positions& perturbed = PerturbedStart();
   const double before = scene.RmsDistanceToTruth(perturbed);
   StereoRefinementOptions options = LevelZeroOverlapOptions();
+  options.concurrent_halves = ConcurrentHalves::kOff;
   const RefinementResult one_chain = scene.Refine(perturbed, 6, options);
-  options.concurrent_halves = true;
+  options.concurrent_halves = ConcurrentHalves::kOn;
   const RefinementResult halves = scene.Refine(perturbed, 6, options);
   ASSERT_EQ(halves.levels.size(), 1u);
   EXPECT_EQ(one_chain.levels[0].windows, 5);  // [0, 1] … [4, 5]
   EXPECT_EQ(halves.levels[0].windows, 5);     // two per half and the seam's
+  EXPECT_FALSE(one_chain.levels[0].concurrent_halves);
+  EXPECT_TRUE(halves.levels[0].concurrent_halves);
   for (std::size_t f = 0; f < halves.control.size(); ++f) {
     EXPECT_GT(halves.frames[f].stereo_pairs, 0) << "frame " << f;
     const double after = scene.RmsDistanceToTruth(halves.control[f]);
     EXPECT_LT(after, before) << "frame " << f;
     EXPECT_LT(after, 1.5 * scene.RmsDistanceToTruth(one_chain.control[f]) + 1e-5) << "frame " << f;
   }
+}
+
+// concurrent_halves = kAuto (the default): side by side where the level's windows go to the
+// iterative solver, whose products run on one thread; one chain where they are factorized.
+TEST(StereoRefinement, AutomaticHalvesWhereTheWindowsAreSolvedIteratively) {
+  const testing::RefinementScene& scene = Scene();
+  StereoRefinementOptions options = LevelZeroOverlapOptions();
+  options.solver.max_iterations = 1;  // the plan does not depend on the solve
+  ASSERT_EQ(options.concurrent_halves, ConcurrentHalves::kAuto);
+  options.solver.iterative_from_unknowns = 1;  // every window iterative
+  const RefinementResult iterative = scene.Refine(PerturbedStart(), 6, options);
+  EXPECT_EQ(iterative.levels.at(0).iterative_windows, iterative.levels[0].windows);
+  EXPECT_TRUE(iterative.levels[0].concurrent_halves);
+  options.solver.iterative_from_unknowns = 0;  // every window factorized
+  const RefinementResult direct = scene.Refine(PerturbedStart(), 6, options);
+  EXPECT_EQ(direct.levels.at(0).iterative_windows, 0);
+  EXPECT_FALSE(direct.levels[0].concurrent_halves);
+  // Too short a take for halves (fewer than 3 windows' frames): one chain whatever the mode.
+  options.concurrent_halves = ConcurrentHalves::kOn;
+  options.window = 3;
+  EXPECT_FALSE(scene.Refine(PerturbedStart(), 6, options).levels.at(0).concurrent_halves);
 }
 
 TEST(StereoRefinement, RejectsBadInput) {
