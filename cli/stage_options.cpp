@@ -158,12 +158,12 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
   sub->add_option_function<std::string>(
          "--concurrent-halves",
          [o](const std::string& text) {
-           o->concurrent_halves = solver::ParseConcurrentHalves(text.empty() ? "on" : text, "--concurrent-halves");
+           o->concurrent_halves = solver::ParseConcurrentHalves(text, "--concurrent-halves");
          },
          "auto|on|off: refine a take of at least 3 windows as two halves side by side, then a window across the "
          "seam; auto = at the levels whose windows go to the iterative solver (faster there, more memory; "
-         "docs/speed.md). Given alone: on. Default: auto")
-      ->expected(0, 1);
+         "docs/speed.md). Default: auto")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   sub->add_option("--rounds", o->rounds, "Visibility updates per level")->capture_default_str();
   sub->add_option("--iterations", o->solver.max_iterations, "Ceres iterations per window and round")
       ->capture_default_str();

@@ -137,12 +137,13 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(NormalFlowSolverOptions, smoothn
                                                 multigrid_min_vertices)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionStepOptions, sampling, visibility, solver, image_sigmas,
                                                 highpass_sigma, first_highpass_sigma)
-// "off", "auto", "on"; option files written before the mode had three values hold a bool
-// (true: "on", false: "off", as those runs did).
+// "off", "auto", "on". Option files written while it was a bool hold true / false: read as
+// "on" / "off", as those runs did (a file without the key takes the default, "auto").
 inline void to_json(nlohmann::json& json, ConcurrentHalves mode) { json = ToString(mode); }
 inline void from_json(const nlohmann::json& json, ConcurrentHalves& mode) {
   if (json.is_boolean()) mode = json.get<bool>() ? ConcurrentHalves::kOn : ConcurrentHalves::kOff;
-  else mode = ParseConcurrentHalves(json.get<std::string>(), "concurrent_halves");
+  else if (json.is_string()) mode = ParseConcurrentHalves(json.get<std::string>(), "concurrent_halves");
+  else ThrowError("options", "concurrent_halves", "expected \"auto\", \"on\" or \"off\", got " + json.dump());
 }
 // WITH_DEFAULT below too.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,

@@ -51,9 +51,10 @@ void FrameImageCache::KeepVisibility(int frame, const Positions& control, FrameV
   visibility_cache_[frame] = {control, std::move(visible)};
 }
 
-void FrameImageCache::Release(int first_kept) {
-  const auto release = [first_kept](auto& cache) {
-    for (auto it = cache.begin(); it != cache.end();) it = it->first < first_kept ? cache.erase(it) : ++it;
+void FrameImageCache::Release(int first_kept, int last_kept) {
+  const auto release = [first_kept, last_kept](auto& cache) {
+    for (auto it = cache.begin(); it != cache.end();)
+      it = it->first < first_kept || it->first > last_kept ? cache.erase(it) : ++it;
   };
   release(gray_cache_);
   release(silhouette_cache_);

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <vector>
@@ -75,8 +76,8 @@ class FrameImageCache {
   void KeepVisibility(int frame, const geometry::Positions& control, FrameVisibility visible);
   // Forgets every frame's visibility (a new level or round).
   void ForgetVisibility() { visibility_cache_.clear(); }
-  // Forgets the frames before `first_kept`.
-  void Release(int first_kept);
+  // Forgets the frames before `first_kept` and after `last_kept`.
+  void Release(int first_kept, int last_kept = std::numeric_limits<int>::max());
 
  private:
   const vision::ImageSequence& images_;

@@ -1,6 +1,7 @@
 #include "solver/stereo/stereo_refinement.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -86,9 +87,10 @@ bool SideBySide(const StereoRefinementOptions& options, const LoopHierarchy& hie
   for (int f = 0; f < F.rows(); ++f)
     if (level.active_faces[f])
       for (int c = 0; c < 3; ++c) corner[F(f, c)] = 1;
-  const long vertices = std::count(corner.begin(), corner.end(), 1);
-  const long unknowns = vertices * level.dof * std::min(options.window, frames);
-  return options.solver.Iterative(static_cast<int>(std::min<long>(unknowns, std::numeric_limits<int>::max())));
+  const std::int64_t vertices = std::count(corner.begin(), corner.end(), 1);
+  const std::int64_t unknowns = vertices * level.dof * std::min(options.window, frames);
+  return options.solver.Iterative(
+      static_cast<int>(std::min<std::int64_t>(unknowns, std::numeric_limits<int>::max())));
 }
 
 // The refinement state of the whole sequence, which the windows' solutions move.
@@ -186,8 +188,12 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   };
   for (int round = 0; round < options.rounds; ++round) {
     std::vector<ChainTally> tallies(plan.halves.size());
-    for (std::size_t i = 0; i < plan.halves.size(); ++i)
+    for (std::size_t i = 0; i < plan.halves.size(); ++i) {
       caches[i]->ForgetVisibility();  // another level's samples, or another round
+      // A level after one run the other way: the frames a cache kept from it that its half
+      // will not read (one chain's last window, in the first half's cache).
+      caches[i]->Release(plan.halves[i].span_first, plan.halves[i].span_last);
+    }
     if (plan.halves.size() == 1) {
       run(plan.halves[0], caches[0], &moved[0], &tallies[0], nullptr);
     } else {
@@ -367,10 +373,13 @@ RefinementResult RefineStereo(const vision::ImageSequence& images, const LoopHie
   FrameImageCache first_half(images, options.image_sigma), second_half(images, options.image_sigma);
   FrameImageCache* const caches[2] = {&first_half, &second_half};
 
-  // Progress counts windows; a level side by side has one more (the seam's) or as many.
+  // Progress counts windows, per level the most either plan has (auto decides per level;
+  // after each level the count moves on to the level's end).
   const int frames = static_cast<int>(control.size());
-  const std::size_t windows =
-      std::max(PlanWindows(frames, options, false).Count(), PlanWindows(frames, options, true).Count());
+  const auto windows_of = [&](bool halves) { return PlanWindows(frames, options, halves).Count(); };
+  const std::size_t windows = options.concurrent_halves == ConcurrentHalves::kAuto
+                                  ? std::max(windows_of(false), windows_of(true))
+                                  : windows_of(options.concurrent_halves == ConcurrentHalves::kOn);
   ProgressBegin(progress, "refinement",
                 static_cast<std::size_t>(finest_refined - options.coarsest_level + 1) * options.rounds * windows);
   std::size_t done = 0;

@@ -124,6 +124,21 @@ TEST(ReconstructCommand, RefusesToOverwriteAndRejectsBadOptions) {
       Scratch().path());
   EXPECT_NE(solver.exit_code, 0);
   EXPECT_NE(solver.err.find("magic"), std::string::npos) << solver.output();
+  // --concurrent-halves takes a value: a bad one, or the dataset after it, is a usage error
+  // naming the flag (the parser's exit code, not a signal: an exception out of the parser's
+  // callback would abort).
+  const test::CommandResult halves = RunSubflow(
+      "reconstruct '" + Dataset().string() + "' --out '" + Scratch().FreshPath("bad3").string() +
+          "' --concurrent-halves sometimes",
+      Scratch().path());
+  EXPECT_TRUE(halves.exit_code > 0 && halves.exit_code < 128) << halves.output();
+  EXPECT_NE(halves.err.find("--concurrent-halves"), std::string::npos) << halves.output();
+  const test::CommandResult swallowed = RunSubflow(
+      "reconstruct --concurrent-halves '" + Dataset().string() + "' --out '" + Scratch().FreshPath("bad4").string() +
+          "'",
+      Scratch().path());
+  EXPECT_TRUE(swallowed.exit_code > 0 && swallowed.exit_code < 128) << swallowed.output();
+  EXPECT_NE(swallowed.err.find("--concurrent-halves"), std::string::npos) << swallowed.output();
 }
 
 }  // namespace

@@ -90,7 +90,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--window", {"4", "/options/refinement/window", 4}},
       {"--window-overlap", {"1", "/options/refinement/window_overlap", 1}},
       {"--rounds", {"2", "/options/refinement/rounds", 2}},
-      {"--concurrent-halves", {"", "/options/refinement/concurrent_halves", "on"}},
+      {"--concurrent-halves", {"on", "/options/refinement/concurrent_halves", "on"}},
       {"--iterations", {"3", "/options/refinement/solver/max_iterations", 3}},
       {"--function-tolerance", {"0.01", "/options/refinement/solver/function_tolerance", 0.01}},
       {"--linear-solver", {"DENSE_QR", "/options/refinement/solver/linear_solver", "dense_qr"}},

@@ -236,6 +236,13 @@ TEST(StereoRefinement, AutomaticHalvesWhereTheWindowsAreSolvedIteratively) {
   const RefinementResult direct = scene.Refine(PerturbedStart(), 6, options);
   EXPECT_EQ(direct.levels.at(0).iterative_windows, 0);
   EXPECT_FALSE(direct.levels[0].concurrent_halves);
+  // The threshold itself: a window of exactly iterative_from_unknowns unknowns goes to the
+  // iterative solver and runs side by side; one more and it is factorized, one chain.
+  const int per_window = direct.levels[0].parameters / direct.levels[0].windows;
+  options.solver.iterative_from_unknowns = per_window;
+  EXPECT_TRUE(scene.Refine(PerturbedStart(), 6, options).levels.at(0).concurrent_halves) << per_window;
+  options.solver.iterative_from_unknowns = per_window + 1;
+  EXPECT_FALSE(scene.Refine(PerturbedStart(), 6, options).levels.at(0).concurrent_halves) << per_window;
   // Too short a take for halves (fewer than 3 windows' frames): one chain whatever the mode.
   options.concurrent_halves = ConcurrentHalves::kOn;
   options.window = 3;
