@@ -143,17 +143,14 @@ PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, std::vector<Pat
       support_(static_cast<int>(stencil_.cols())),
       dof_(dof),
       epsilon_(epsilon) {
-  const auto support = static_cast<std::size_t>(stencil_.cols());
-  const auto m = static_cast<std::size_t>(stencil_.rows());
   for (const PatchView& view : views_) {
-    if (!view.image || !view.camera || !view.base.all || !view.basis.all || view.base.size() != m ||
-        view.basis.size() != support)
+    if (!ViewFitsStencil(view, stencil_))
       ThrowError("PatchCorrelationCost", "view",
                  "needs an image, a camera, one position per sample and one basis per support "
                  "vertex, with its blocks inside the block count");
     first_blocks_.push_back(view.first_block);
   }
-  Setup(static_cast<int>(views_.size()), static_cast<int>(m), block_count);
+  Setup(static_cast<int>(views_.size()), static_cast<int>(stencil_.rows()), block_count);
 }
 
 PatchCorrelationCost::PatchCorrelationCost(PatchStencil stencil, PatchView a, PatchView b,

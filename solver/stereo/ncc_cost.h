@@ -78,6 +78,13 @@ struct PatchView {
 // Limit-stencil weights of the samples on the patch's support vertices (m × #support,
 // dense: supports are small, 12 for a regular patch).
 using PatchStencil = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// Whether `view` can be sampled with `stencil`: it has an image, a camera, one position
+// per stencil row and one basis per stencil column.
+inline bool ViewFitsStencil(const PatchView& view, const PatchStencil& stencil) {
+  return view.image && view.camera && view.base.all && view.basis.all &&
+         view.base.size() == static_cast<std::size_t>(stencil.rows()) &&
+         view.basis.size() == static_cast<std::size_t>(stencil.cols());
+}
 // Jacobians of intensity vectors: one row per sample (row-major, rows are gathered).
 using RowJacobian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 

@@ -73,6 +73,11 @@ RefinementLevel PrepareLevel(const LoopHierarchy& hierarchy, const std::vector<v
   prepared.sampling = SampleLevel(hierarchy, level, reference_level, cameras, options, &active_faces);
   prepared.visibility = std::make_unique<VisibilityTester>(hierarchy, hierarchy.finest_level(), options.visibility);
   prepared.active_faces = std::move(active_faces);
+  const geometry::Faces& F = hierarchy.LevelFaces(level);
+  prepared.active_vertices.assign(hierarchy.VertexCount(level), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (prepared.active_faces[f])
+      for (int k = 0; k < 3; ++k) prepared.active_vertices[F(f, k)] = 1;
   return prepared;
 }
 
@@ -100,11 +105,7 @@ RefinementWindow OpenWindow(const RefinementLevel& level, const LoopHierarchy& h
                    std::to_string(window.span_first) + "–" + std::to_string(window.SpanLast()));
   window.h = level.h;
   window.active_faces = level.active_faces;
-  const geometry::Faces& F = hierarchy.LevelFaces(level.level);
-  window.active_vertices.assign(hierarchy.VertexCount(level.level), 0);
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    if (window.active_faces[f])
-      for (int k = 0; k < 3; ++k) window.active_vertices[F(f, k)] = 1;
+  window.active_vertices = level.active_vertices;
   const int c0 = std::max(window.span_first, first - 1), c1 = std::min(window.SpanLast(), last + 1);
   const bool rim = options.rim_band > 0 && options.silhouette_weight > 0 &&
                    level.level >= options.silhouette_from_level;

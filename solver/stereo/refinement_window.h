@@ -143,6 +143,7 @@ struct RefinementLevel {
   LevelSampling sampling;
   std::unique_ptr<VisibilityTester> visibility;  // of the finest level's limit surface
   std::vector<char> active_faces;                // #F(ℓ)
+  std::vector<char> active_vertices;             // #V(ℓ): corners of active faces
 };
 
 // Level ℓ of the refinement of `trajectory` (its middle frame is the reference): dof by

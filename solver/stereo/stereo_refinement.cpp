@@ -79,15 +79,9 @@ WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options, bool 
 // Whether the windows of `level` run as two halves side by side (concurrent_halves): kAuto
 // when a window of the level (its frames × the active patches' corners × dof unknowns)
 // goes to the iterative solver, whose products run on one thread.
-bool SideBySide(const StereoRefinementOptions& options, const LoopHierarchy& hierarchy, const RefinementLevel& level,
-                int frames) {
+bool SideBySide(const StereoRefinementOptions& options, const RefinementLevel& level, int frames) {
   if (options.concurrent_halves != ConcurrentHalves::kAuto) return options.concurrent_halves == ConcurrentHalves::kOn;
-  const geometry::Faces& F = hierarchy.LevelFaces(level.level);
-  std::vector<char> corner(hierarchy.VertexCount(level.level), 0);
-  for (int f = 0; f < F.rows(); ++f)
-    if (level.active_faces[f])
-      for (int c = 0; c < 3; ++c) corner[F(f, c)] = 1;
-  const std::int64_t vertices = std::count(corner.begin(), corner.end(), 1);
+  const std::int64_t vertices = std::count(level.active_vertices.begin(), level.active_vertices.end(), 1);
   const std::int64_t unknowns = vertices * level.dof * std::min(options.window, frames);
   return options.solver.Iterative(
       static_cast<int>(std::min<std::int64_t>(unknowns, std::numeric_limits<int>::max())));
@@ -159,7 +153,7 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   report.active_patches = static_cast<int>(std::count(prepared.active_faces.begin(), prepared.active_faces.end(), 1));
   report.active_fraction = static_cast<double>(report.active_patches) / report.patches;
   const int frames = static_cast<int>(state->result->control.size());
-  const WindowPlan plan = PlanWindows(frames, options, SideBySide(options, hierarchy, prepared, frames));
+  const WindowPlan plan = PlanWindows(frames, options, SideBySide(options, prepared, frames));
   report.windows = static_cast<int>(plan.Count());
   report.concurrent_halves = plan.halves.size() > 1;
   // Per half: the largest displacement of every vertex (the halves write different frames).

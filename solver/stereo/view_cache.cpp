@@ -31,11 +31,7 @@ const SampledView* ViewCache::Add(int frame, int camera, int face, const PatchSt
     entry->view.first_block = 0;
     entry->stencil = &stencil;
     entry->increments = std::move(increments);
-    const auto m = static_cast<std::size_t>(stencil.rows());
-    if (!entry->view.image || !entry->view.camera || !entry->view.base.all || !entry->view.basis.all ||
-        entry->view.base.size() != m ||
-        entry->view.basis.size() != static_cast<std::size_t>(stencil.cols()) ||
-        entry->increments.size() != entry->view.basis.size())
+    if (!ViewFitsStencil(entry->view, stencil) || entry->increments.size() != entry->view.basis.size())
       ThrowError("ViewCache", "view", "needs an image, a camera, one position per sample and one basis and "
                                       "one parameter block per support vertex");
     entry->sampled.intensities.setZero(stencil.rows());
