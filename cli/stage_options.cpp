@@ -116,6 +116,10 @@ void AddShapeInitOptions(CLI::App* sub, solver::ShapeInitOptions* o, std::string
 void AddMotionInitOptions(CLI::App* sub, solver::MotionInitOptions* o, bool first_pass) {
   sub->add_option("--motion-smoothness", o->step.solver.smoothness,
                   "Smoothness weight of the normal-flow solver (aperture problem)")->capture_default_str();
+  sub->add_flag_callback(
+      "--no-velocity-guess", [o] { o->guess_previous_step = false; },
+      "Motion passes: do not try the previous step (a constant velocity) as a step's start; each step starts at "
+      "zero motion (or, in the retrack, at the refined surface when that matches the images better)");
   if (!first_pass) return;  // the retrack's are --retrack-highpass and --retrack-weight
   sub->add_option("--motion-highpass", o->step.highpass_sigma,
                   "First motion pass on the log intensities minus their blur of this sigma (pixels): gain "

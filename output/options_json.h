@@ -148,7 +148,7 @@ inline void from_json(const nlohmann::json& json, ConcurrentHalves& mode) {
 // WITH_DEFAULT below too.
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MotionInitOptions, step, hull_weight, hull_max_distance,
                                                 hull_iterations, registration, guess_from_targets,
-                                                spread_registration, registration_min_unreached,
+                                                guess_previous_step, spread_registration, registration_min_unreached,
                                                 concurrent_chains)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WindowSolverOptions, linear_solver, max_iterations, threads,
                                                 function_tolerance, iterative_from_unknowns, iterative_solver,
@@ -180,6 +180,9 @@ inline void from_json(const nlohmann::json& json, ReconstructionOptions& options
   options.retrack_highpass = json.value("retrack_highpass", options.motion.step.highpass_sigma);
   // Those written before the retrack registered lost frames (2026-12-06) did not.
   options.retrack_register = json.value("retrack_register", false);
+  // Those written before the motion passes tried the previous step as a start (2026-12-07)
+  // did not.
+  options.motion.guess_previous_step = json.at("motion_init").value("guess_previous_step", false);
 }
 
 }  // namespace subflow::solver

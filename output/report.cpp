@@ -241,8 +241,9 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
       if (f.unreached_before_registration >= 0.0)
         frames.back()["registration"]["unreached_before"] = f.unreached_before_registration;
     }
-    if (o.guess_from_targets && f.from_frame >= 0)
+    if ((o.guess_from_targets || o.guess_previous_step) && f.from_frame >= 0)
       frames.back()["guess"] = {{"used", f.step.guess_used},
+                                {"source", solver::ToString(f.guess_source)},
                                 {"photometric_rms", f.step.guess_rms},
                                 {"photometric_rms_zero_motion", f.step.guess_rms_zero}};
   }

@@ -302,6 +302,16 @@ void SeedStageInput(StageRecord* in, const std::string& seed) {
   state.reference_frame = frame;
   state.control[frame - state.first_frame] = source.state.control.front();
   in->report["seed"] = {{"folder", fs::absolute(seed).lexically_normal().string()}, {"frame", frame}};
+  // The seed's step into the shared frame, when the seed holds the frame before it (this
+  // range continues forwards) or after it (backwards): the first step here may start at it.
+  const int direction = frame == state.first_frame && frame - 1 >= seed_first                       ? +1
+                        : frame == state.first_frame + state.frame_count() - 1 && frame + 1 < seed_end ? -1
+                                                                                                      : 0;
+  if (direction != 0) {
+    const StageRecord before = ReadStageFolder(seed, "", frame - direction, 1);
+    state.lead_in = solver::MotionLeadIn{direction, source.state.control.front() - before.state.control.front()};
+    in->report["seed"]["lead_in_frame"] = frame - direction;
+  }
 }
 
 }  // namespace subflow::output

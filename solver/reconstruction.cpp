@@ -147,9 +147,11 @@ StageState RunMotionStage(const vision::Dataset& dataset, const StageState& in, 
                           Progress* progress, MotionInitResult* figures) {
   in.Check("motion stage input");
   const vision::ImageSequence images = StageImages(dataset, in);
-  *figures = InitializeMotion(images, in.Hierarchy(), in.control, in.reference_index(), options, progress);
+  *figures = InitializeMotion(images, in.Hierarchy(), in.control, in.reference_index(), options, progress,
+                              in.lead_in ? &*in.lead_in : nullptr);
   StageState out = in;
   out.control = figures->control;
+  out.lead_in.reset();  // the input's, used
   return out;
 }
 

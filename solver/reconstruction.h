@@ -104,6 +104,9 @@ struct StageState {
   // When set, cameras whose silhouettes come from a background image take them, recomputed
   // per frame with these options, as masks (SilhouetteOptions::background_outlines).
   std::optional<vision::SilhouetteOptions> background_outlines;
+  // A motion or retrack input seeded from an earlier chunk's stage folder (output::
+  // SeedStageInput): that chunk's step into the reference frame, where it has one.
+  std::optional<MotionLeadIn> lead_in;
 
   int frame_count() const { return static_cast<int>(control.size()); }
   int reference_index() const { return reference_frame - first_frame; }

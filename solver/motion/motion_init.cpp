@@ -21,6 +21,15 @@ namespace subflow::solver {
 
 using geometry::Positions;
 
+const char* ToString(GuessSource source) {
+  switch (source) {
+    case GuessSource::kTarget: return "target";
+    case GuessSource::kPreviousStep: return "previous_step";
+    case GuessSource::kZero: break;
+  }
+  return "zero";
+}
+
 std::string MotionInitResult::BriefReport() const {
   double zero = 0, estimated = 0;
   int steps = 0;
@@ -74,7 +83,7 @@ namespace {
 // `initial_control` has one matrix per frame (else only the reference frame's).
 bool CheckMotionInputs(const vision::ImageSequence& images, const geometry::LoopHierarchy& hierarchy,
                        const std::vector<Positions>& initial_control, int reference_frame,
-                       const MotionInitOptions& options) {
+                       const MotionInitOptions& options, const MotionLeadIn* lead_in) {
   options.Check();
   images.Check("motion init");
   const int frame_count = images.frame_count;
@@ -98,7 +107,37 @@ bool CheckMotionInputs(const vision::ImageSequence& images, const geometry::Loop
       ThrowError("motion init", "initial control points of frame " + std::to_string(f),
                  std::to_string(initial_control[f].rows()) + " rows, expected 0 or " +
                      std::to_string(vertices));
+  if (lead_in && (std::abs(lead_in->direction) != 1 || lead_in->step.rows() != vertices || !lead_in->step.allFinite()))
+    ThrowError("motion init", "lead-in step", "expected direction ±1 and #V(n) = " + std::to_string(vertices) +
+                                                  " finite rows");
   return per_frame;
+}
+
+// A still: no step to estimate, nor anything to build for one.
+MotionInitResult StillMotion(int reference_frame, const Positions& reference, const Stopwatch& start) {
+  MotionInitResult still;
+  still.reference_frame = reference_frame;
+  still.control = {reference};
+  still.frames.resize(1);
+  still.seconds = start.Seconds();
+  return still;
+}
+
+// The first pass's starts besides zero motion for a step from `control` (the step takes the
+// one that matches the images best): towards the next frame's `target` (retrack), and the
+// chain's `previous_step` (empty: none yet); `sources` says which is which.
+std::vector<Positions> StepGuesses(const MotionInitOptions& options, const Positions& control, const Positions* target,
+                                   const Positions& previous_step, std::vector<GuessSource>* sources) {
+  std::vector<Positions> guesses;
+  if (options.guess_from_targets && target) {
+    guesses.push_back(*target - control);
+    sources->push_back(GuessSource::kTarget);
+  }
+  if (options.guess_previous_step && previous_step.rows() > 0) {
+    guesses.push_back(previous_step);
+    sources->push_back(GuessSource::kPreviousStep);
+  }
+  return guesses;
 }
 
 // The displacement `shift` that a registration added at frame `to` built up since frame
@@ -155,21 +194,14 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
                                   const geometry::LoopHierarchy& hierarchy,
                                   const std::vector<Positions>& initial_control,
                                   int reference_frame, const MotionInitOptions& options,
-                                  Progress* progress) {
+                                  Progress* progress, const MotionLeadIn* lead_in) {
   const Stopwatch start;
-  const bool per_frame = CheckMotionInputs(images, hierarchy, initial_control, reference_frame, options);
+  const bool per_frame = CheckMotionInputs(images, hierarchy, initial_control, reference_frame, options, lead_in);
   const std::vector<vision::Camera>& cameras = images.cameras;
   const int frame_count = images.frame_count;
   const int n = hierarchy.finest_level();
   const Positions& reference = per_frame ? initial_control[reference_frame] : initial_control[0];
-  if (frame_count == 1) {  // a still: no step to estimate, nor anything to build for one
-    MotionInitResult still;
-    still.reference_frame = reference_frame;
-    still.control = {reference};
-    still.frames.resize(1);
-    still.seconds = start.Seconds();
-    return still;
-  }
+  if (frame_count == 1) return StillMotion(reference_frame, reference, start);
   auto fitted = [&](int frame) -> const Positions* {
     if (!per_frame || initial_control[frame].rows() == 0) return nullptr;
     return &initial_control[frame];
@@ -203,17 +235,18 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   // Returns the registration's displacement of `to` when it was registered and
   // options.spread_registration is set (else empty).
   auto propagate = [&](int from, int to, const std::vector<cv::Mat>& from_images,
-                       const std::vector<cv::Mat>& to_images) {
+                       const std::vector<cv::Mat>& to_images, Positions* previous_step) {
     Positions shift;
     const Positions* target = fitted(to);
-    Positions guess;
-    if (options.guess_from_targets && target) guess = *target - result.control[from];
-    const MotionStep step =
-        estimator.Estimate(result.control[from], from_images, to_images, guess.rows() > 0 ? &guess : nullptr);
+    std::vector<GuessSource> sources;
+    const std::vector<Positions> guesses = StepGuesses(options, result.control[from], target, *previous_step, &sources);
+    const MotionStep step = estimator.Estimate(result.control[from], from_images, to_images, guesses);
+    *previous_step = step.displacement;
     Positions control = result.control[from] + step.displacement;
     MotionFrameReport& report = result.frames[to];
     report.from_frame = from;
     report.step = step.report;
+    report.guess_source = step.report.guess_index >= 0 ? sources[step.report.guess_index] : GuessSource::kZero;
     report.identical_images = IdenticalImages(from_images, to_images);
     if (report.identical_images)
       spdlog::warn("motion init: frame {} is identical to frame {} in every camera (a repeated frame, as capture "
@@ -243,11 +276,13 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
   auto chain = [&](int direction, const TaskErrors* group) {
     std::vector<cv::Mat> current = reference_images;
     int anchor = reference_frame;  // the last frame registered (or the reference)
+    // The chain's last step: none yet, or the one of the chain this one continues.
+    Positions previous_step = lead_in && lead_in->direction == direction ? lead_in->step : Positions();
     for (int f = reference_frame; f + direction >= 0 && f + direction < frame_count; f += direction) {
       if (group && group->failed()) return;
       std::vector<cv::Mat> next = load(f + direction);
       const int to = f + direction;
-      const Positions shift = propagate(f, to, current, next);
+      const Positions shift = propagate(f, to, current, next, &previous_step);
       if (shift.rows() > 0) {
         SpreadBack(shift, anchor, to, &result.control);
         anchor = to;

@@ -65,6 +65,11 @@ struct MotionInitOptions {
   // pass, whose targets are the refined shapes — one connectivity whose vertices already
   // follow the material — not for independent per-frame fits (shape initialization's).
   bool guess_from_targets = false;
+  // Also offer the first pass the chain's previous step (a constant velocity: at video rates
+  // a point's motion changes little from one frame to the next), taken only where it
+  // matches the images better than zero motion and the other guesses. Measured on the
+  // scenes (docs/shape.md, "A constant velocity as the first pass's start").
+  bool guess_previous_step = true;
   // When a frame is registered, spread the registration's displacement back over the
   // chain's frames since the previous registered frame (or the reference), in proportion
   // to their distance from it: the surface that fell behind its targets over those frames
@@ -82,8 +87,13 @@ struct MotionInitOptions {
   void Check() const;  // throws subflow::Error naming the field
 };
 
+// Where a step's first pass started.
+enum class GuessSource { kZero, kTarget, kPreviousStep };
+const char* ToString(GuessSource source);
+
 struct MotionFrameReport {
   int frame = 0;
+  GuessSource guess_source = GuessSource::kZero;
   int from_frame = -1;  // the frame it was propagated from; −1 for the reference frame
   bool identical_images = false;  // every camera's image equals from_frame's (a duplicated frame)
   MotionStepReport step;
@@ -126,16 +136,24 @@ geometry::Positions CorrectTowardsFit(const geometry::LoopHierarchy& hierarchy,
                                       const MotionInitOptions& options, double max_correction,
                                       MotionFrameReport* report, geometry::Positions* registration_shift = nullptr);
 
+// A chain that continues another's (a chunk of a plan seeded at its first or last frame,
+// docs/cluster.md): that chain's step into the reference frame, so that the first step here
+// may start at it as the next step of one chain would (MotionInitOptions::guess_previous_step).
+struct MotionLeadIn {
+  int direction = 0;          // +1: the step came from the frame before the reference; −1: after it
+  geometry::Positions step;   // #V(n)×3: control(reference) − control(reference − direction)
+};
+
 // Trajectories for the frames of `images` (its gray images; frames and reference_frame
 // are window frames). `initial_control`: either one matrix (the reference frame's fitted
 // finest control points) or one per frame (images.frame_count entries; the reference
 // frame's must be non-empty, others may be empty = no fit for that frame, no correction
-// there). Throws subflow::Error on sizes, a reference frame out of range, or invalid
-// options.
+// there). `lead_in` (optional): the chain in its direction starts with that previous step.
+// Throws subflow::Error on sizes, a reference frame out of range, or invalid options.
 MotionInitResult InitializeMotion(const vision::ImageSequence& images,
                                   const geometry::LoopHierarchy& hierarchy,
                                   const std::vector<geometry::Positions>& initial_control,
                                   int reference_frame, const MotionInitOptions& options,
-                                  Progress* progress = nullptr);
+                                  Progress* progress = nullptr, const MotionLeadIn* lead_in = nullptr);
 
 }  // namespace subflow::solver

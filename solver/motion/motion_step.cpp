@@ -69,7 +69,8 @@ MotionStepEstimator::MotionStepEstimator(const geometry::LoopHierarchy& hierarch
 
 MotionStep MotionStepEstimator::Estimate(const Positions& control,
                                          const std::vector<cv::Mat>& before,
-                                         const std::vector<cv::Mat>& after, const Positions* guess) const {
+                                         const std::vector<cv::Mat>& after,
+                                         const std::vector<Positions>& guesses) const {
   const auto start = std::chrono::steady_clock::now();
   const int n = hierarchy_->finest_level();
   if (control.rows() != hierarchy_->VertexCount(n))
@@ -96,11 +97,9 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
   step.report.multi_view_samples = visibility.SamplesSeenBy(2);
   step.displacement = Positions::Zero(control.rows(), 3);
   Positions sample_motion;  // empty: zero guess on the first pass
-  if (guess) {
-    if (guess->rows() != control.rows() || guess->cols() != 3 || !guess->allFinite())
+  for (const Positions& guess : guesses)
+    if (guess.rows() != control.rows() || guess.cols() != 3 || !guess.allFinite())
       ThrowError("motion step", "guess", "expected #V(n) = " + std::to_string(control.rows()) + " finite rows");
-    sample_motion = solver_.SampleMotion(*guess);
-  }
   const int passes = static_cast<int>(options_.image_sigmas.size());
   // The first of several passes on a coarser high-pass: its wider linear range brings a
   // motion of a few pixels within the fine structure's.
@@ -121,15 +120,23 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
     smoothed_before = SmoothAll(structure_before, options_.image_sigmas[pass]);
     smoothed_after = SmoothAll(structure_after, options_.image_sigmas[pass]);
     if (pass + 1 == passes || pass_highpass(pass + 1) != highpass) structure_before = structure_after = {};
-    if (pass == 0 && guess) {
-      // The guess is a start, not a given: where it matches the images worse than no motion
+    if (pass == 0 && !guesses.empty()) {
+      // A guess is a start, not a given: where it matches the images worse than no motion
       // does (trajectories that jump from frame to frame), the step starts from zero.
-      step.report.guess_rms = Rms(StepPhotometricDifferences(cameras_, smoothed_before, smoothed_after, positions,
-                                                             sample_motion, visibility));
       step.report.guess_rms_zero = Rms(StepPhotometricDifferences(cameras_, smoothed_before, smoothed_after,
                                                                   positions, Positions(), visibility));
+      for (std::size_t g = 0; g < guesses.size(); ++g) {
+        Positions motion = solver_.SampleMotion(guesses[g]);
+        const double rms = Rms(StepPhotometricDifferences(cameras_, smoothed_before, smoothed_after, positions,
+                                                          motion, visibility));
+        if (g == 0 || rms < step.report.guess_rms) {
+          step.report.guess_rms = rms;
+          step.report.guess_index = static_cast<int>(g);
+          sample_motion = std::move(motion);
+        }
+      }
       step.report.guess_used = step.report.guess_rms < step.report.guess_rms_zero;
-      if (!step.report.guess_used) sample_motion = Positions();
+      if (!step.report.guess_used) sample_motion = Positions(), step.report.guess_index = -1;
     }
     const NormalFlowConstraints constraints = BuildStepConstraints(
         cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility);

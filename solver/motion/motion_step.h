@@ -73,11 +73,12 @@ struct MotionStepReport {
   double photometric_rms_zero = 0.0;
   double photometric_rms = 0.0;
   double mean_displacement = 0.0;  // mean |∂c| over the finest control points
-  // With a guess: the RMS as above at the first pass's σ for the guess and for zero motion;
-  // the guess is used only when it is the better start.
+  // With guesses: the RMS as above at the first pass's σ for the best guess and for zero
+  // motion; the guess is used only when it is the better start.
   double guess_rms = 0.0;
   double guess_rms_zero = 0.0;
   bool guess_used = false;
+  int guess_index = -1;  // the guess the first pass started at (−1: zero motion)
   int cg_iterations = 0;           // over all passes
   double seconds = 0.0;
 };
@@ -101,12 +102,13 @@ class MotionStepEstimator {
   MotionStepEstimator& operator=(const MotionStepEstimator&) = delete;
 
   // Displacement of `control` (finest control points at the `before` frame) between the
-  // two sets of images (one per camera). `guess` (optional, #V(n)×3): a displacement the
-  // first pass linearizes at instead of zero (e.g. the step of trajectories known to be
-  // close), so that fewer passes from coarse σ are needed; ignored when it matches the
-  // images worse than zero motion (report.guess_used).
+  // two sets of images (one per camera). `guesses` (each #V(n)×3; none = start at zero):
+  // displacements the first pass may linearize at instead of zero (e.g. the step of
+  // trajectories known to be close, or the previous step's: a constant velocity), so that a
+  // motion beyond the linear range is still found. The first pass starts at whichever of
+  // zero motion and the guesses matches the images best (report.guess_used, guess_index).
   MotionStep Estimate(const geometry::Positions& control, const std::vector<cv::Mat>& before,
-                      const std::vector<cv::Mat>& after, const geometry::Positions* guess = nullptr) const;
+                      const std::vector<cv::Mat>& after, const std::vector<geometry::Positions>& guesses = {}) const;
 
   const SurfaceSamples& samples() const { return samples_; }
   const VisibilityTester& visibility() const { return visibility_; }

@@ -91,6 +91,11 @@ TEST(PlanCommand, ThePlanRunsChainedChunksAndRestarts) {
   // shared frame, so no vertex jumps at the boundary.
   const fs::path dir = PlanDirectory();
   EXPECT_EQ(ReadJson(dir / "motion_2" / "report.json")["seed"]["frame"], 7);
+  // …and its first step may start at the step motion_1 took into that frame (from 6), as
+  // one chain's would; motion_0 continues motion_1 backwards from frame 4 (its step from 5).
+  EXPECT_EQ(ReadJson(dir / "motion_2" / "report.json")["seed"]["lead_in_frame"], 6);
+  EXPECT_EQ(ReadJson(dir / "motion_0" / "report.json")["seed"]["lead_in_frame"], 5);
+  EXPECT_TRUE(ReadJson(dir / "motion_2" / "report.json")["motion_init"]["frames"][1]["guess"].contains("source"));
   EXPECT_EQ(Control(dir / "motion_2", "000007"), Control(dir / "motion_1", "000007"));
   EXPECT_EQ(Control(dir / "motion_0", "000004"), Control(dir / "motion_1", "000004"));
   EXPECT_EQ(Control(dir / "retrack_2", "000007"), Control(dir / "retrack_1", "000007"));

@@ -125,6 +125,19 @@ TEST(OptionsJson, AnOlderFileWithoutTheBackdropTakesItsDefaults) {
   EXPECT_TRUE(older.shape.still.backdrop.enabled);
 }
 
+// The motion passes try the previous step as a start since 2026-12-07: an options file
+// written before has no guess_previous_step and reads as off, as its runs did.
+TEST(OptionsJson, AnOlderFileKeepsItsStepsWithoutTheVelocityGuess) {
+  solver::ReconstructionOptions options;
+  ASSERT_TRUE(options.motion.guess_previous_step);
+  nlohmann::json json = options;
+  EXPECT_TRUE(json.get<solver::ReconstructionOptions>().motion.guess_previous_step);
+  json["motion_init"].erase("guess_previous_step");
+  const solver::ReconstructionOptions older = json.get<solver::ReconstructionOptions>();
+  EXPECT_FALSE(older.motion.guess_previous_step);
+  EXPECT_FALSE(older.RetrackOptions().guess_previous_step);
+}
+
 // concurrent_halves was a bool before it had an automatic mode: an older file's true / false
 // reads as "on" / "off" (what those runs did), the mode's names round-trip, others fail.
 TEST(OptionsJson, ConcurrentHalvesReadsTheOlderBoolAndTheModesNames) {

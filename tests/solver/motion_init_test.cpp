@@ -66,7 +66,7 @@ struct TranslationStepsWithGuess {
         truth(Translated(scene.control, t) - scene.control),
         guess(Translated(scene.control, guess_t) - scene.control),
         from_zero(estimator.Estimate(scene.control, before, after)),
-        from_guess(estimator.Estimate(scene.control, before, after, &guess)) {}
+        from_guess(estimator.Estimate(scene.control, before, after, {guess})) {}
   double Error(const Positions& displacement) const {
     return SampleMotionError(estimator, scene.control, displacement, truth);
   }
@@ -127,7 +127,22 @@ TEST(MotionStep, AGuessNearTheMotionIsFollowedCloserThanAStartFromZero) {
   EXPECT_TRUE(steps.from_guess.report.guess_used);
   EXPECT_LT(steps.from_guess.report.guess_rms, steps.from_guess.report.guess_rms_zero);
   const Positions wrong = Positions::Zero(3, 3);
-  EXPECT_THROW(steps.estimator.Estimate(steps.scene.control, steps.before, steps.after, &wrong), Error);
+  EXPECT_THROW(steps.estimator.Estimate(steps.scene.control, steps.before, steps.after, {steps.guess, wrong}), Error);
+}
+
+// Of several guesses the first pass starts at the one that matches the images best: a guess
+// 12 mm the wrong way beside the one near the motion changes nothing, to the bit.
+TEST(MotionStep, TheBestOfSeveralGuessesIsTheStart) {
+  const TranslationStepsWithGuess steps(Eigen::Vector3d(0.006, -0.004, 0.003), Eigen::Vector3d(0.007, -0.0032, 0.0024));
+  const Positions wrong = TranslationStepsWithGuess::Translated(steps.scene.control, Eigen::Vector3d(-0.008, 0.007, -0.006)) -
+                          steps.scene.control;
+  for (const std::vector<Positions>& guesses : {std::vector<Positions>{wrong, steps.guess},
+                                                std::vector<Positions>{steps.guess, wrong}}) {
+    const MotionStep step = steps.estimator.Estimate(steps.scene.control, steps.before, steps.after, guesses);
+    EXPECT_TRUE(step.report.guess_used);
+    EXPECT_EQ(step.report.guess_index, guesses[0].isApprox(wrong) ? 1 : 0);
+    EXPECT_EQ(step.displacement, steps.from_guess.displacement);
+  }
 }
 
 // A guess that matches the images worse than no motion (refined shapes that jump from frame
@@ -275,6 +290,59 @@ TEST(MotionInit, PropagatesForwardAndBackwardOnOneHierarchy) {
   const MotionInitResult one_after_the_other = InitializeMotion(images_of_frames, scene.hierarchy, fitted, 1, serial);
   for (int f = 0; f < 3; ++f)
     EXPECT_EQ((one_after_the_other.control[f] - result.control[f]).cwiseAbs().maxCoeff(), 0.0) << "frame " << f;
+}
+
+// A take that moves fast and steadily: 8 mm (≈ 5 px) a frame, far beyond the image passes'
+// linear range, for 4 frames. From zero motion every step recovers it to a few per cent;
+// started at the previous step (a constant velocity), the steps after the first land several
+// times closer, and report that start.
+TEST(MotionInit, AConstantVelocityStartsEachStepAtThePreviousOne) {
+  const MotionTestScene& scene = Scene();
+  const Eigen::Vector3d t(0.006, -0.004, 0.003);
+  std::vector<std::vector<cv::Mat>> frames;
+  for (int f = 0; f < 4; ++f)
+    frames.push_back(testing::RenderGray(scene, TranslationStepsWithGuess::Translated(scene.mesh.V, f * t)));
+  const vision::ImageSequence images{scene.cameras, 0, 4, [&](int camera, int frame) { return frames[frame][camera]; },
+                                     {}, {}};
+  const Positions truth = TranslationStepsWithGuess::Translated(scene.control, t) - scene.control;
+  const MotionStepEstimator measure(scene.hierarchy, scene.cameras, scene.control);
+  auto step_error = [&](const MotionInitResult& r, int f) {  // the step f → f + 1
+    const Positions at = r.control[f];
+    return SampleMotionError(measure, at, r.control[f + 1] - at, truth);
+  };
+  MotionInitOptions options;
+  ASSERT_TRUE(options.guess_previous_step);
+  const MotionInitResult velocity = InitializeMotion(images, scene.hierarchy, {scene.control}, 0, options);
+  options.guess_previous_step = false;
+  const MotionInitResult zero = InitializeMotion(images, scene.hierarchy, {scene.control}, 0, options);
+  for (int f = 0; f < 3; ++f)
+    std::printf("step %d→%d: sample motion error from zero %.2f %%, with the previous step as a start %.2f %%\n", f,
+                f + 1, 100 * step_error(zero, f), 100 * step_error(velocity, f));
+  EXPECT_EQ(step_error(velocity, 0), step_error(zero, 0));  // no previous step yet
+  EXPECT_EQ(velocity.frames[1].guess_source, GuessSource::kZero);
+  for (int f = 1; f < 3; ++f) {
+    EXPECT_EQ(velocity.frames[f + 1].guess_source, GuessSource::kPreviousStep) << "frame " << f + 1;
+    EXPECT_LT(step_error(zero, f), 0.10) << "step " << f;
+    EXPECT_LT(step_error(velocity, f), 0.3 * step_error(zero, f)) << "step " << f;
+  }
+
+  // A chain that continues another (a plan's chunk seeded at frame 1, docs/cluster.md): with
+  // the step into its reference frame as its lead-in, its first step starts there too. A
+  // lead-in of the other direction is not this chain's.
+  const vision::ImageSequence rest{scene.cameras, 0, 3,
+                                   [&](int camera, int frame) { return frames[frame + 1][camera]; }, {}, {}};
+  options.guess_previous_step = true;
+  MotionLeadIn lead_in{+1, velocity.control[1] - velocity.control[0]};
+  const MotionInitResult continued =
+      InitializeMotion(rest, scene.hierarchy, {velocity.control[1]}, 0, options, nullptr, &lead_in);
+  EXPECT_EQ(continued.frames[1].guess_source, GuessSource::kPreviousStep);
+  EXPECT_LT(step_error(continued, 0), 0.3 * step_error(zero, 1));
+  lead_in.direction = -1;
+  const MotionInitResult other =
+      InitializeMotion(rest, scene.hierarchy, {velocity.control[1]}, 0, options, nullptr, &lead_in);
+  EXPECT_EQ(other.frames[1].guess_source, GuessSource::kZero);
+  lead_in.step = Positions::Zero(3, 3);
+  EXPECT_THROW(InitializeMotion(rest, scene.hierarchy, {velocity.control[1]}, 0, options, nullptr, &lead_in), Error);
 }
 
 // A duplicated frame (capture software repeats a frame when it drops one): frames 0, 1, 1
