@@ -241,11 +241,15 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
       if (f.unreached_before_registration >= 0.0)
         frames.back()["registration"]["unreached_before"] = f.unreached_before_registration;
     }
-    if ((o.guess_from_targets || o.guess_previous_step) && f.from_frame >= 0)
-      frames.back()["guess"] = {{"used", f.step.guess_used},
+    if (!f.guesses_offered.empty()) {
+      nlohmann::json offered = nlohmann::json::array();
+      for (solver::GuessSource source : f.guesses_offered) offered.push_back(solver::ToString(source));
+      frames.back()["guess"] = {{"offered", offered},
+                                {"used", f.step.guess_used},
                                 {"source", solver::ToString(f.guess_source)},
                                 {"photometric_rms", f.step.guess_rms},
                                 {"photometric_rms_zero_motion", f.step.guess_rms_zero}};
+    }
   }
   return {{"options", o},
           {"reference_frame", first_frame + result.reference_frame},

@@ -247,6 +247,7 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     report.from_frame = from;
     report.step = step.report;
     report.guess_source = step.report.guess_index >= 0 ? sources[step.report.guess_index] : GuessSource::kZero;
+    report.guesses_offered = std::move(sources);
     report.identical_images = IdenticalImages(from_images, to_images);
     if (report.identical_images)
       spdlog::warn("motion init: frame {} is identical to frame {} in every camera (a repeated frame, as capture "

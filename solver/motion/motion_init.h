@@ -93,7 +93,8 @@ const char* ToString(GuessSource source);
 
 struct MotionFrameReport {
   int frame = 0;
-  GuessSource guess_source = GuessSource::kZero;
+  std::vector<GuessSource> guesses_offered;  // the starts the first pass was offered besides zero
+  GuessSource guess_source = GuessSource::kZero;  // the one it took
   int from_frame = -1;  // the frame it was propagated from; −1 for the reference frame
   bool identical_images = false;  // every camera's image equals from_frame's (a duplicated frame)
   MotionStepReport step;
@@ -137,10 +138,12 @@ geometry::Positions CorrectTowardsFit(const geometry::LoopHierarchy& hierarchy,
                                       MotionFrameReport* report, geometry::Positions* registration_shift = nullptr);
 
 // A chain that continues another's (a chunk of a plan seeded at its first or last frame,
-// docs/cluster.md): that chain's step into the reference frame, so that the first step here
-// may start at it as the next step of one chain would (MotionInitOptions::guess_previous_step).
+// docs/cluster.md): the other chain's velocity at the reference frame, from its control
+// points there and at the frame beside it, offered to the first step here as its previous
+// step (MotionInitOptions::guess_previous_step). Within a chain the previous step is the
+// flow alone; this difference of control points also holds the other chain's corrections.
 struct MotionLeadIn {
-  int direction = 0;          // +1: the step came from the frame before the reference; −1: after it
+  int direction = 0;          // +1: the chain continues forwards (the frame beside is before); −1: backwards
   geometry::Positions step;   // #V(n)×3: control(reference) − control(reference − direction)
 };
 

@@ -97,9 +97,10 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
   step.report.multi_view_samples = visibility.SamplesSeenBy(2);
   step.displacement = Positions::Zero(control.rows(), 3);
   Positions sample_motion;  // empty: zero guess on the first pass
-  for (const Positions& guess : guesses)
+  for (const Positions& guess : guesses) {
     if (guess.rows() != control.rows() || guess.cols() != 3 || !guess.allFinite())
       ThrowError("motion step", "guess", "expected #V(n) = " + std::to_string(control.rows()) + " finite rows");
+  }
   const int passes = static_cast<int>(options_.image_sigmas.size());
   // The first of several passes on a coarser high-pass: its wider linear range brings a
   // motion of a few pixels within the fine structure's.
@@ -136,7 +137,10 @@ MotionStep MotionStepEstimator::Estimate(const Positions& control,
         }
       }
       step.report.guess_used = step.report.guess_rms < step.report.guess_rms_zero;
-      if (!step.report.guess_used) sample_motion = Positions(), step.report.guess_index = -1;
+      if (!step.report.guess_used) {
+        sample_motion = Positions();
+        step.report.guess_index = -1;
+      }
     }
     const NormalFlowConstraints constraints = BuildStepConstraints(
         cameras_, smoothed_before, smoothed_after, positions, sample_motion, visibility);

@@ -91,11 +91,24 @@ TEST(PlanCommand, ThePlanRunsChainedChunksAndRestarts) {
   // shared frame, so no vertex jumps at the boundary.
   const fs::path dir = PlanDirectory();
   EXPECT_EQ(ReadJson(dir / "motion_2" / "report.json")["seed"]["frame"], 7);
-  // …and its first step may start at the step motion_1 took into that frame (from 6), as
-  // one chain's would; motion_0 continues motion_1 backwards from frame 4 (its step from 5).
+  // …and its first step is offered motion_1's velocity at that frame (its control points
+  // at 6 and 7) as its previous step, as the next step of one chain is offered its previous
+  // one; motion_0 continues motion_1 backwards from frame 4 (with frame 5). motion_1's own
+  // first steps, from the reference frame 6, are offered nothing.
+  auto offered = [&](const char* task, int frame) {
+    const nlohmann::json report = ReadJson(dir / task / "report.json");  // named: the loop reads into it
+    for (const auto& f : report["motion_init"]["frames"])
+      if (f["frame"] == frame) return f.contains("guess") ? f["guess"]["offered"] : nlohmann::json::array();
+    ADD_FAILURE() << task << " has no frame " << frame;
+    return nlohmann::json();
+  };
   EXPECT_EQ(ReadJson(dir / "motion_2" / "report.json")["seed"]["lead_in_frame"], 6);
   EXPECT_EQ(ReadJson(dir / "motion_0" / "report.json")["seed"]["lead_in_frame"], 5);
-  EXPECT_TRUE(ReadJson(dir / "motion_2" / "report.json")["motion_init"]["frames"][1]["guess"].contains("source"));
+  EXPECT_EQ(offered("motion_2", 8), nlohmann::json::array({"previous_step"}));
+  EXPECT_EQ(offered("motion_0", 3), nlohmann::json::array({"previous_step"}));
+  EXPECT_EQ(offered("motion_1", 7), nlohmann::json::array());
+  EXPECT_EQ(offered("motion_1", 5), nlohmann::json::array());
+  EXPECT_EQ(offered("motion_1", 4), nlohmann::json::array({"previous_step"}));  // its second step backwards
   EXPECT_EQ(Control(dir / "motion_2", "000007"), Control(dir / "motion_1", "000007"));
   EXPECT_EQ(Control(dir / "motion_0", "000004"), Control(dir / "motion_1", "000004"));
   EXPECT_EQ(Control(dir / "retrack_2", "000007"), Control(dir / "retrack_1", "000007"));
