@@ -246,7 +246,7 @@ nlohmann::json MotionInitJson(const solver::MotionInitOptions& o, const solver::
       for (solver::GuessSource source : f.guesses_offered) offered.push_back(solver::ToString(source));
       frames.back()["guess"] = {{"offered", offered},
                                 {"used", f.step.guess_used},
-                                {"source", solver::ToString(f.guess_source)},
+                                {"source", solver::ToString(f.guess_source())},
                                 {"photometric_rms", f.step.guess_rms},
                                 {"photometric_rms_zero_motion", f.step.guess_rms_zero}};
     }

@@ -296,20 +296,23 @@ void SeedStageInput(StageRecord* in, const std::string& seed) {
                "shares no frame with the input's [" + std::to_string(state.first_frame) + ", " +
                    std::to_string(state.first_frame + state.frame_count()) + ")");
   const int frame = std::clamp(report.at("reference_frame").get<int>(), first, end - 1);
-  const StageRecord source = ReadStageFolder(seed, "", frame, 1);
-  if (source.state.base_mesh.F != state.base_mesh.F)
-    ThrowError(seed, "base_mesh.ply", "another connectivity than the input's");
-  state.reference_frame = frame;
-  state.control[frame - state.first_frame] = source.state.control.front();
-  in->report["seed"] = {{"folder", fs::absolute(seed).lexically_normal().string()}, {"frame", frame}};
-  // The seed's step into the shared frame, when the seed holds the frame before it (this
-  // range continues forwards) or after it (backwards): the first step here may start at it.
+  // The seed's velocity at the shared frame, when the seed holds the frame before it (this
+  // range continues forwards) or after it (backwards): offered to the first step here as its
+  // previous step. Both frames in one read.
   const int direction = frame == state.first_frame && frame - 1 >= seed_first                       ? +1
                         : frame == state.first_frame + state.frame_count() - 1 && frame + 1 < seed_end ? -1
                                                                                                       : 0;
+  const StageRecord source = ReadStageFolder(seed, "", std::min(frame, frame - direction), direction != 0 ? 2 : 1);
+  if (source.state.base_mesh.F != state.base_mesh.F)
+    ThrowError(seed, "base_mesh.ply", "another connectivity than the input's");
+  const auto control_at = [&](int f) -> const geometry::Positions& {
+    return source.state.control[f - source.state.first_frame];
+  };
+  state.reference_frame = frame;
+  state.control[frame - state.first_frame] = control_at(frame);
+  in->report["seed"] = {{"folder", fs::absolute(seed).lexically_normal().string()}, {"frame", frame}};
   if (direction != 0) {
-    const StageRecord before = ReadStageFolder(seed, "", frame - direction, 1);
-    state.lead_in = solver::MotionLeadIn{direction, source.state.control.front() - before.state.control.front()};
+    state.lead_in = solver::MotionLeadIn{direction, control_at(frame) - control_at(frame - direction)};
     in->report["seed"]["lead_in_frame"] = frame - direction;
   }
 }

@@ -105,7 +105,7 @@ struct StageState {
   // per frame with these options, as masks (SilhouetteOptions::background_outlines).
   std::optional<vision::SilhouetteOptions> background_outlines;
   // A motion or retrack input seeded from an earlier chunk's stage folder (output::
-  // SeedStageInput): that chunk's step into the reference frame, where it has one.
+  // SeedStageInput): that chunk's velocity at the reference frame, where it has one.
   std::optional<MotionLeadIn> lead_in;
 
   int frame_count() const { return static_cast<int>(control.size()); }

@@ -30,6 +30,10 @@ const char* ToString(GuessSource source) {
   return "zero";
 }
 
+GuessSource MotionFrameReport::guess_source() const {
+  return step.guess_index >= 0 ? guesses_offered.at(step.guess_index) : GuessSource::kZero;
+}
+
 std::string MotionInitResult::BriefReport() const {
   double zero = 0, estimated = 0;
   int steps = 0;
@@ -246,7 +250,6 @@ MotionInitResult InitializeMotion(const vision::ImageSequence& images,
     MotionFrameReport& report = result.frames[to];
     report.from_frame = from;
     report.step = step.report;
-    report.guess_source = step.report.guess_index >= 0 ? sources[step.report.guess_index] : GuessSource::kZero;
     report.guesses_offered = std::move(sources);
     report.identical_images = IdenticalImages(from_images, to_images);
     if (report.identical_images)

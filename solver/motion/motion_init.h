@@ -94,7 +94,6 @@ const char* ToString(GuessSource source);
 struct MotionFrameReport {
   int frame = 0;
   std::vector<GuessSource> guesses_offered;  // the starts the first pass was offered besides zero
-  GuessSource guess_source = GuessSource::kZero;  // the one it took
   int from_frame = -1;  // the frame it was propagated from; −1 for the reference frame
   bool identical_images = false;  // every camera's image equals from_frame's (a duplicated frame)
   MotionStepReport step;
@@ -109,6 +108,9 @@ struct MotionFrameReport {
   // > 0; else −1).
   double unreached_before_registration = -1.0;
   SurfaceRegistrationReport registration;  // measured whenever corrected; `applied` when registered
+
+  // The start the first pass took: one of guesses_offered (step.guess_index), or zero motion.
+  GuessSource guess_source() const;
 };
 
 struct MotionInitResult {

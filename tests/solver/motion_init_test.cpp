@@ -319,9 +319,9 @@ TEST(MotionInit, AConstantVelocityStartsEachStepAtThePreviousOne) {
     std::printf("step %d→%d: sample motion error from zero %.2f %%, with the previous step as a start %.2f %%\n", f,
                 f + 1, 100 * step_error(zero, f), 100 * step_error(velocity, f));
   EXPECT_EQ(step_error(velocity, 0), step_error(zero, 0));  // no previous step yet
-  EXPECT_EQ(velocity.frames[1].guess_source, GuessSource::kZero);
+  EXPECT_EQ(velocity.frames[1].guess_source(), GuessSource::kZero);
   for (int f = 1; f < 3; ++f) {
-    EXPECT_EQ(velocity.frames[f + 1].guess_source, GuessSource::kPreviousStep) << "frame " << f + 1;
+    EXPECT_EQ(velocity.frames[f + 1].guess_source(), GuessSource::kPreviousStep) << "frame " << f + 1;
     EXPECT_LT(step_error(zero, f), 0.10) << "step " << f;
     EXPECT_LT(step_error(velocity, f), 0.3 * step_error(zero, f)) << "step " << f;
   }
@@ -335,12 +335,12 @@ TEST(MotionInit, AConstantVelocityStartsEachStepAtThePreviousOne) {
   MotionLeadIn lead_in{+1, velocity.control[1] - velocity.control[0]};
   const MotionInitResult continued =
       InitializeMotion(rest, scene.hierarchy, {velocity.control[1]}, 0, options, nullptr, &lead_in);
-  EXPECT_EQ(continued.frames[1].guess_source, GuessSource::kPreviousStep);
+  EXPECT_EQ(continued.frames[1].guess_source(), GuessSource::kPreviousStep);
   EXPECT_LT(step_error(continued, 0), 0.3 * step_error(zero, 1));
   lead_in.direction = -1;
   const MotionInitResult other =
       InitializeMotion(rest, scene.hierarchy, {velocity.control[1]}, 0, options, nullptr, &lead_in);
-  EXPECT_EQ(other.frames[1].guess_source, GuessSource::kZero);
+  EXPECT_EQ(other.frames[1].guess_source(), GuessSource::kZero);
   lead_in.step = Positions::Zero(3, 3);
   EXPECT_THROW(InitializeMotion(rest, scene.hierarchy, {velocity.control[1]}, 0, options, nullptr, &lead_in), Error);
 }
