@@ -155,7 +155,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WindowSolverOptions, linear_solv
                                                 iterative_eta, reduced_correlation_blocks)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
                                    per_patch_levels, detail_threshold, min_detail_patch_area,
-                                   normal_only_from_level, window, window_overlap, concurrent_halves, rounds, solver,
+                                   normal_only_from_level, tangential_only_at_outlines, window, window_overlap, concurrent_halves, rounds, solver,
                                    samples_per_pixel, min_density, max_density, max_cameras, min_samples,
                                    image_sigma, ncc_epsilon, ncc_loss_scale, temporal_weight, silhouette_weight,
                                    silhouette_from_level, rim_band, angle_weight_power, outline_margin, membrane_weight, temporal_smoothness,

@@ -138,12 +138,15 @@ FrameState MakeFrameState(const LoopHierarchy& hierarchy, int level, int dof,
   state.basis.resize(vertices);
   if (level == 0) {
     const Positions normals = geometry::LimitNormals(hierarchy, 0, state.level_control);
+    // Normal first, then two tangents (dof 3), so that holding a vertex to its normal keeps
+    // its first increment.
     for (int v = 0; v < vertices; ++v) {
+      const Eigen::Vector3d n = normals.row(v).transpose();
+      state.basis[v].setZero();
+      state.basis[v].col(0) = n;
       if (dof == 3) {
-        state.basis[v].setIdentity();
-      } else {
-        state.basis[v].setZero();
-        state.basis[v].col(0) = normals.row(v).transpose();
+        state.basis[v].col(1) = n.unitOrthogonal();
+        state.basis[v].col(2) = n.cross(state.basis[v].col(1));
       }
     }
   } else {

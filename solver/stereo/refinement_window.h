@@ -6,9 +6,9 @@
 // Per frame t of the window and its context frames (FrameState):
 //   c(ℓ)       the level-ℓ control points of the current shape (#V(ℓ)×3)
 //   B_v        per level-ℓ vertex v, the 3×3 basis of its increment e_v: the Hoppe frame
-//              (n, r, q) of C c(ℓ−1) at v for details (ℓ > 0), the identity for base
-//              control points (ℓ = 0, dof 3) or the limit normal in column 0 (dof 1); the
-//              first `dof` columns are used
+//              (n, r, q) of C c(ℓ−1) at v for details (ℓ > 0); for base control points
+//              (ℓ = 0) the limit normal and, for dof 3, two tangents; the first `dof`
+//              columns are used
 //   X, n       per sample (LevelSampling), the position and unit normal of the current
 //              finest limit surface
 //   usable     per camera and sample: visible (VisibilityTester) and, where the camera has
@@ -21,6 +21,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -124,6 +125,9 @@ struct RefinementWindow {
   // Where the correlation blocks' views are sampled once per evaluation point (the
   // problem's evaluation callback, view_cache.h); null: each block samples its own.
   ViewCache* views = nullptr;
+  // The increment blocks that a measured outline's block moves (options
+  // tangential_only_at_outlines): filled as the silhouette residuals are added.
+  std::unordered_set<const double*> sliding;
 
   int SpanLast() const { return span_last < 0 ? frame_count - 1 : span_last; }
   double* Increment(int frame, int vertex) {

@@ -82,7 +82,10 @@ WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options, bool 
 bool SideBySide(const StereoRefinementOptions& options, const RefinementLevel& level, int frames) {
   if (options.concurrent_halves != ConcurrentHalves::kAuto) return options.concurrent_halves == ConcurrentHalves::kOn;
   const std::int64_t vertices = std::count(level.active_vertices.begin(), level.active_vertices.end(), 1);
-  const std::int64_t unknowns = vertices * level.dof * std::min(options.window, frames);
+  // Held to their normals, most vertices of a dof-3 level count once (the few that
+  // measured outlines move count thrice, not estimated here).
+  const int per_vertex = level.dof == 3 && options.tangential_only_at_outlines ? 1 : level.dof;
+  const std::int64_t unknowns = vertices * per_vertex * std::min(options.window, frames);
   return options.solver.Iterative(
       static_cast<int>(std::min<std::int64_t>(unknowns, std::numeric_limits<int>::max())));
 }

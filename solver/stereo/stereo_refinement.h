@@ -138,6 +138,16 @@ struct StereoRefinementOptions {
   // itself), so by default every level keeps the tangential motion of motion
   // initialization and corrects the shape along the normals.
   int normal_only_from_level = 0;
+  // On the levels below normal_only_from_level (dof 3), only the vertices at measured
+  // outlines (the corners of a patch with an outline or rim block from a camera whose
+  // silhouette is the object's own: masks, a plain backdrop, a background image) may slide
+  // along the surface; every other vertex stays on its normal (a Ceres SubsetManifold), as
+  // with dof 1. Sliding is what the outlines ask for (a web between two legs moved up into
+  // the crotch); elsewhere stereo barely constrains it. On rigs all around the subject
+  // nearly every base patch has such a block (nothing is held); on a front rig the back is
+  // held. Measured on the scenes (docs/shape.md, "Sliding at the outlines"): off by default
+  // (normal_only_from_level 0), `--slide-at-outlines` turns it on at the base level.
+  bool tangential_only_at_outlines = false;
   int window = 6;                  // frames solved jointly
   // Frames shared by consecutive windows: the last `window_overlap` frames of a window are
   // solved again, from their refined state, as the first frames of the next one, so that

@@ -75,6 +75,23 @@ void BuildResiduals(RefinementWindow& window, ceres::LossFunction* ncc_loss, cer
   }
 }
 
+// Holds every free increment block of the window's frames that no measured outline moves
+// (window.sliding) to its normal: only its first coordinate varies. Returns how many.
+int HoldToNormals(RefinementWindow& window, ceres::Manifold* normal_only, ceres::Problem* problem) {
+  int held = 0;
+  const int vertices = static_cast<int>(window.active_vertices.size());
+  for (int t = window.first; t <= window.last; ++t)
+    for (int v = 0; v < vertices; ++v) {
+      double* block = window.Increment(t, v);
+      if (!problem->HasParameterBlock(block) || problem->IsParameterBlockConstant(block) ||
+          window.sliding.count(block))
+        continue;
+      problem->SetManifold(block, normal_only);
+      ++held;
+    }
+  return held;
+}
+
 }  // namespace
 
 WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bounds) {
@@ -85,6 +102,8 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.evaluation_callback = &views;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::SubsetManifold normal_only(3, {1, 2});  // outlives the problem
   ceres::Problem problem(problem_options);
   std::unique_ptr<ceres::LossFunction> ncc_loss;
   if (options.ncc_loss_scale > 0) ncc_loss = std::make_unique<ceres::CauchyLoss>(options.ncc_loss_scale);
@@ -95,6 +114,12 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
   solution.first = window.first;
   solution.last = window.last;
   solution.parameters = BoundIncrements(window, bounds, &problem);
+  if (window.dof == 3 && options.tangential_only_at_outlines) {
+    const int held = HoldToNormals(window, &normal_only, &problem);
+    spdlog::debug("refinement level {} frames {}–{}: {} of {} vertex blocks held to their normals", window.level,
+                  window.first, window.last, held, solution.parameters / 3);
+    solution.parameters -= 2 * held;
+  }
   solution.residual_blocks = problem.NumResidualBlocks();
 
   const int frames = window.frame_count;

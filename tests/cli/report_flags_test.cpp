@@ -86,6 +86,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--motion-highpass", {"1.2", "/options/motion_init/step/highpass_sigma", 1.2}},
       {"--hull-weight", {"0.4", "/options/motion_init/hull_weight", 0.4}},
       {"--no-velocity-guess", {"", "/options/motion_init/guess_previous_step", false}},
+      {"--slide-at-outlines", {"", "/options/refinement/tangential_only_at_outlines", true}},
       {"--refine-from", {"1", "/options/refinement/coarsest_level", 1}},
       {"--refine-to", {"1", "/options/refinement/finest_level", 1}},
       {"--window", {"4", "/options/refinement/window", 4}},

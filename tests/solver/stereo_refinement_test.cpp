@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -163,6 +164,51 @@ TEST(StereoRefinement, WindowsRecordTheirLinearSolver) {
   const WindowSolution nothing = SolveWindow(idle.window, Scene().bounds);
   EXPECT_EQ(nothing.residual_blocks, 0);
   EXPECT_FALSE(nothing.iterative);
+}
+
+// dof 3 on the base level with tangential_only_at_outlines: the corners of patches with a
+// measured outline's block may slide; the others are held to their normals (their
+// tangential increments stay zero and count nothing among the window's unknowns). A surface
+// shrunk by 1.5 px has rim blocks all along its rims; with the masks of two of the 8
+// cameras only, only along those two.
+TEST(StereoRefinement, OnlyTheVerticesThatOutlinesMoveSlide) {
+  StereoRefinementOptions options = TestOptions();
+  options.normal_only_from_level = 1;
+  options.tangential_only_at_outlines = true;
+  const Positions shrunk = testing::Shrunk(Scene(), 1.5);
+  std::vector<cv::Mat> two_masks(Scene().masks.size());
+  two_masks[0] = Scene().masks[0];
+  two_masks[4] = Scene().masks[4];
+  testing::OpenedWindow opened(Scene(), shrunk, 1, 0, 0, 0, options, &two_masks);
+  ASSERT_EQ(opened.window.dof, 3);
+  const WindowSolution solution = SolveWindow(opened.window, Scene().bounds);
+  ASSERT_EQ(solution.increments.size(), 1u);
+  const WindowSolution::Increments& e = solution.increments[0];
+  int sliding = 0, held = 0, slid = 0;
+  for (Eigen::Index v = 0; v < e.rows(); ++v) {
+    if (opened.window.sliding.count(opened.window.Increment(0, static_cast<int>(v)))) {
+      ++sliding;
+      slid += e.row(v).tail(2).norm() > 0;
+      continue;
+    }
+    ++held;
+    EXPECT_EQ(e(v, 1), 0.0) << "vertex " << v;
+    EXPECT_EQ(e(v, 2), 0.0) << "vertex " << v;
+  }
+  EXPECT_GT(sliding, 0);
+  EXPECT_GT(held, 0);
+  EXPECT_GT(slid, sliding / 2);
+  EXPECT_EQ(solution.parameters, held + 3 * sliding);
+
+  // Without the option every vertex is free along the surface.
+  options.tangential_only_at_outlines = false;
+  testing::OpenedWindow free(Scene(), shrunk, 1, 0, 0, 0, options, &two_masks);
+  const WindowSolution everywhere = SolveWindow(free.window, Scene().bounds);
+  EXPECT_EQ(everywhere.parameters, 3 * (held + sliding));
+  int moved = 0;
+  for (Eigen::Index v = 0; v < everywhere.increments[0].rows(); ++v)
+    moved += everywhere.increments[0].row(v).tail(2).norm() > 0;
+  EXPECT_GT(moved, sliding);
 }
 
 // Level 0 only, 2-frame windows sharing one frame.
