@@ -147,8 +147,16 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
                               int level, std::vector<char> active_faces, FrameImageCache* const caches[2],
                               SequenceState* state, Progress* progress, std::size_t* progress_done) {
   const Stopwatch start;
-  const RefinementLevel prepared =
+  RefinementLevel prepared =
       PrepareLevel(hierarchy, images.cameras, options, state->trajectory, level, std::move(active_faces));
+  // Sliding only at measured outlines, and none is measured (every silhouette a projected
+  // hull, or none): every vertex would be held to its normal, so the level keeps dof 1 (the
+  // same unknowns, a third of the Jacobian's columns).
+  const bool outlines_measured =
+      images.silhouette && (images.tight_outline.empty() ||
+                            std::count(images.tight_outline.begin(), images.tight_outline.end(), 0) <
+                                static_cast<std::ptrdiff_t>(images.tight_outline.size()));
+  if (prepared.dof == 3 && options.tangential_only_at_outlines && !outlines_measured) prepared.dof = 1;
   RefinementLevelReport report;
   report.level = level;
   report.dof = prepared.dof;

@@ -211,6 +211,30 @@ TEST(StereoRefinement, OnlyTheVerticesThatOutlinesMoveSlide) {
   EXPECT_GT(moved, sliding);
 }
 
+// With tangential_only_at_outlines and no measured outline (every camera's silhouette a
+// projected hull, which only bounds the object) every vertex would be held, so the base level
+// keeps dof 1; with the masks it has dof 3, and so has the hulls' without the restriction.
+TEST(StereoRefinement, WithoutAMeasuredOutlineNothingSlides) {
+  const testing::RefinementScene& scene = Scene();
+  StereoRefinementOptions options = TestOptions();
+  options.finest_level = 0;
+  options.normal_only_from_level = 1;
+  options.tangential_only_at_outlines = true;
+  options.solver.threads = 2;
+  vision::ImageSequence hulls = scene.Sequence(2);
+  hulls.tight_outline.assign(hulls.cameras.size(), 0);
+  const std::vector<Positions> start(2, scene.scene.control);
+  const RefinementResult loose = RefineStereo(hulls, scene.scene.hierarchy, start, scene.bounds, options);
+  ASSERT_EQ(loose.levels.size(), 1u);
+  EXPECT_EQ(loose.levels[0].dof, 1);
+  const RefinementResult masked = scene.Refine(scene.scene.control, 2, options);
+  ASSERT_EQ(masked.levels.size(), 1u);
+  EXPECT_EQ(masked.levels[0].dof, 3);
+  options.tangential_only_at_outlines = false;
+  const RefinementResult everywhere = RefineStereo(hulls, scene.scene.hierarchy, start, scene.bounds, options);
+  EXPECT_EQ(everywhere.levels[0].dof, 3);
+}
+
 // Level 0 only, 2-frame windows sharing one frame.
 StereoRefinementOptions LevelZeroOverlapOptions() {
   StereoRefinementOptions options = TestOptions();
