@@ -231,6 +231,7 @@ void AddSilhouetteResiduals(RefinementWindow& window, int frame, int face, ceres
   const int m = window.sampling->FaceSampleCount(face);
   const int first = window.sampling->face_first[face];
   const Eigen::Vector3i corners = window.hierarchy->LevelFaces(window.level).row(face).transpose();
+  const bool held_elsewhere = window.dof == 3 && options.tangential_only_at_outlines;  // HoldToNormals reads sliding
   const auto add = [&](int k, int i, bool one_sided) {
     std::vector<double*> blocks;
     AppendBlocks(window, frame, support, &blocks);
@@ -239,7 +240,7 @@ void AddSilhouetteResiduals(RefinementWindow& window, int frame, int face, ceres
                                     stencil.row(i).transpose(), BasesOf(window, frame, support), window.dof,
                                     options.silhouette_weight, one_sided);
     records->push_back({problem->AddResidualBlock(cost, nullptr, blocks), frame, nullptr});
-    if (window.images->TightOutline(k))  // tangential_only_at_outlines: these corners may slide
+    if (held_elsewhere && window.images->TightOutline(k))  // these corners may slide
       for (int c = 0; c < 3; ++c) window.sliding.insert(window.Increment(frame, corners(c)));
   };
   const Eigen::Vector3d X = window.states.at(frame).positions.row(first + m / 2).transpose();

@@ -154,8 +154,8 @@ std::vector<char> RefineLevel(const vision::ImageSequence& images, const LoopHie
   // same unknowns, a third of the Jacobian's columns).
   const bool outlines_measured =
       images.silhouette && (images.tight_outline.empty() ||
-                            std::count(images.tight_outline.begin(), images.tight_outline.end(), 0) <
-                                static_cast<std::ptrdiff_t>(images.tight_outline.size()));
+                            std::any_of(images.tight_outline.begin(), images.tight_outline.end(),
+                                        [](char tight) { return tight != 0; }));
   if (prepared.dof == 3 && options.tangential_only_at_outlines && !outlines_measured) prepared.dof = 1;
   RefinementLevelReport report;
   report.level = level;
