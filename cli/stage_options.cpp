@@ -201,6 +201,9 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
       },
       "Base level: vertices at measured outlines (masks, a plain backdrop, a background image) may also slide along "
       "the surface (thin parts 3-9 % more accurate on the scenes; the refinement 1.2-3x slower)");
+  sub->add_option("--slide-coherence", o->slide_coherence,
+                  "Where vertices slide: weight of the first difference of their sliding over the frames")
+      ->capture_default_str();
   sub->add_option("--silhouette-from-level", o->silhouette_from_level,
                   "Coarsest level with outline blocks (a base-level block drags a wide region)")->capture_default_str();
   sub->add_option("--rim-band", o->rim_band,

@@ -155,7 +155,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(WindowSolverOptions, linear_solv
                                                 iterative_eta, reduced_correlation_blocks)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(StereoRefinementOptions, coarsest_level, finest_level, min_patch_area,
                                    per_patch_levels, detail_threshold, min_detail_patch_area,
-                                   normal_only_from_level, tangential_only_at_outlines, window, window_overlap, concurrent_halves, rounds, solver,
+                                   normal_only_from_level, tangential_only_at_outlines, slide_coherence, window, window_overlap, concurrent_halves, rounds, solver,
                                    samples_per_pixel, min_density, max_density, max_cameras, min_samples,
                                    image_sigma, ncc_epsilon, ncc_loss_scale, temporal_weight, silhouette_weight,
                                    silhouette_from_level, rim_band, angle_weight_power, outline_margin, membrane_weight, temporal_smoothness,
@@ -183,6 +183,9 @@ inline void from_json(const nlohmann::json& json, ReconstructionOptions& options
   // Those written before the motion passes tried the previous step as a start (2026-12-07)
   // did not.
   options.motion.guess_previous_step = json.at("motion_init").value("guess_previous_step", false);
+  // Those written before the sliding vertices were tied over the frames (2026-12-08) were
+  // not.
+  options.refinement.slide_coherence = json.at("refinement").value("slide_coherence", 0.0);
 }
 
 }  // namespace subflow::solver

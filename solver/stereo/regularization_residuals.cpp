@@ -53,6 +53,20 @@ void AddTemporalSmoothnessResidual(RefinementWindow& window, int frame, int vert
   problem->AddResidualBlock(new LinearResidualCost(std::move(A), std::move(offset)), nullptr, blocks);
 }
 
+void AddSlideCoherenceResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem) {
+  const double weight = window.options->slide_coherence;
+  if (weight <= 0 || window.dof != 3 || frame <= window.span_first || !window.states.count(frame - 1)) return;
+  double* now = window.Increment(frame, vertex);
+  double* before = window.Increment(frame - 1, vertex);
+  if (window.options->tangential_only_at_outlines && !window.sliding.count(now) && !window.sliding.count(before))
+    return;
+  const Eigen::MatrixXd basis = window.Basis(frame, vertex);  // (n, t1, t2)
+  const Eigen::MatrixXd tangents = basis.rightCols(2).transpose();
+  const double w = weight * (1.0 / window.h);
+  std::vector<Eigen::MatrixXd> A{w * tangents * basis, -w * tangents * window.Basis(frame - 1, vertex)};
+  problem->AddResidualBlock(new LinearResidualCost(std::move(A)), nullptr, std::vector<double*>{now, before});
+}
+
 void AddDampingResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem) {
   const double weight = window.options->damping;
   if (weight <= 0) return;

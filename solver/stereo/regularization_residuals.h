@@ -10,6 +10,11 @@
 //                        only, since the base control points' world trajectories
 //                        accelerate with the rigid motion itself (a rotating or swinging
 //                        object), which a smoothness term would fight;
+//   slide coherence      w_c/h T_tᵀ (B_t e_t − B_{t−1} e_{t−1}) where the vertex may slide
+//                        (dof 3; with tangential_only_at_outlines, where it slides at t or
+//                        t − 1): the first difference of its tangential increments in frame
+//                        t's tangent plane T_t (the basis' columns 1 and 2), so that the
+//                        vertex slides alike over the frames (2 residuals);
 //   damping              w_d/h e_v;
 //   bounds               |e_v,d| ≤ max_step · h per component and, for the normal-only
 //                        parametrization, c(ℓ)_v + n e_v inside the working volume (the
@@ -24,9 +29,10 @@
 namespace subflow::solver {
 
 // Each adds at most one block for vertex `vertex` at window frame `frame` (none when the
-// term's weight is 0, the vertex has no ring, or the frame has no neighbour on both sides).
+// term's weight is 0, the vertex has no ring, or the frame lacks the neighbours the term reads).
 void AddMembraneResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem);
 void AddTemporalSmoothnessResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem);
+void AddSlideCoherenceResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem);
 void AddDampingResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem);
 
 // Holds the blocks of the context frames and of inactive vertices constant and bounds the

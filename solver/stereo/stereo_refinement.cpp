@@ -332,6 +332,7 @@ void StereoRefinementOptions::Check() const {
   require(temporal_weight >= 0 && silhouette_weight >= 0 && membrane_weight >= 0 &&
               temporal_smoothness >= 0 && damping >= 0,
           "weights", "must be ≥ 0");
+  require(slide_coherence >= 0, "slide_coherence", "must be ≥ 0 (0 = off)");
   require(silhouette_from_level >= 0, "silhouette_from_level", "must be ≥ 0");
   require(rim_band >= 0, "rim_band", "must be ≥ 0 (pixels; 0 = off)");
   require(min_patch_area > 0, "min_patch_area", "must be > 0 (pixels²)");

@@ -148,6 +148,13 @@ struct StereoRefinementOptions {
   // held. Measured on the scenes (docs/shape.md, "Sliding at the outlines"): off by default
   // (normal_only_from_level 0), `--slide-at-outlines` turns it on at the base level.
   bool tangential_only_at_outlines = false;
+  // Where a vertex may slide (dof 3), a first difference of its tangential increments over
+  // consecutive frames, in frame t's tangent plane: the vertices slide alike over the
+  // frames. Sliding a base control point along a curved coarse surface changes the shape,
+  // and differently in each frame without it; the retrack then carries that inconsistency
+  // into the flow (bust_front EPE_rel +15 %). Measured with --slide-at-outlines in
+  // docs/shape.md, "Sliding at the outlines". Option files from before it read 0 (none).
+  double slide_coherence = 1.0;
   int window = 6;                  // frames solved jointly
   // Frames shared by consecutive windows: the last `window_overlap` frames of a window are
   // solved again, from their refined state, as the first frames of the next one, so that

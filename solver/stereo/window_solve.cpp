@@ -70,6 +70,7 @@ void BuildResiduals(RefinementWindow& window, ceres::LossFunction* ncc_loss, cer
       if (!window.active_vertices[v]) continue;
       AddMembraneResidual(window, t, v, problem);
       AddTemporalSmoothnessResidual(window, t, v, problem);
+      AddSlideCoherenceResidual(window, t, v, problem);
       AddDampingResidual(window, t, v, problem);
     }
   }

@@ -146,7 +146,7 @@ std::map<std::string, Case> Cases(const Inputs& in) {
                  {"--iterations", "3"}, {"--linear-solver", "DENSE_QR"}, {"--threads", "1"},
                  {"--iterative-from-unknowns", "100"}, {"--iterative-solver", "DENSE_QR"},
                  {"--samples-per-pixel", "0.5"}, {"--max-cameras", "4"}, {"--temporal-weight", "0.5"},
-                 {"--silhouette-weight", "0.1"}, {"--silhouette-from-level", "1"}, {"--slide-at-outlines", ""}, {"--rim-band", "1.5"}, {"--membrane-weight", "0.2"}, {"--temporal-smoothness", "0.2"},
+                 {"--silhouette-weight", "0.1"}, {"--silhouette-from-level", "1"}, {"--slide-at-outlines", ""}, {"--rim-band", "1.5"}, {"--membrane-weight", "0.2"}, {"--temporal-smoothness", "0.2"}, {"--slide-coherence", "2.5"},
                  {"--function-tolerance", "0.004"}}}},
       {"import", {"import middlebury " + Quoted(in.calibration) + " --images " + Quoted(in.images) + " --out " + Out("o_import"),
                   "o_import/report.json",

@@ -107,6 +107,7 @@ std::map<std::string, Recorded> ReconstructFlags() {
       {"--rim-band", {"1.5", "/options/refinement/rim_band", 1.5}},
       {"--membrane-weight", {"0.2", "/options/refinement/membrane_weight", 0.2}},
       {"--temporal-smoothness", {"0.2", "/options/refinement/temporal_smoothness", 0.2}},
+      {"--slide-coherence", {"2.5", "/options/refinement/slide_coherence", 2.5}},
   };
 }
 

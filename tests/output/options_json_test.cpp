@@ -154,5 +154,17 @@ TEST(OptionsJson, ConcurrentHalvesReadsTheOlderBoolAndTheModesNames) {
   EXPECT_THROW(json.get<solver::ReconstructionOptions>(), Error);
 }
 
+// The sliding vertices are tied over the frames since 2026-12-08: an options file written
+// before has no slide_coherence and reads as 0, as its runs did.
+TEST(OptionsJson, AnOlderFileHasNoSlideCoherence) {
+  solver::ReconstructionOptions options;
+  ASSERT_GT(options.refinement.slide_coherence, 0.0);
+  options.refinement.slide_coherence = 2.5;
+  nlohmann::json json = options;
+  EXPECT_EQ(json.get<solver::ReconstructionOptions>().refinement.slide_coherence, 2.5);
+  json["refinement"].erase("slide_coherence");
+  EXPECT_EQ(json.get<solver::ReconstructionOptions>().refinement.slide_coherence, 0.0);
+}
+
 }  // namespace
 }  // namespace subflow::output

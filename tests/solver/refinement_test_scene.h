@@ -81,9 +81,14 @@ struct OpenedWindow {
   OpenedWindow(const RefinementScene& scene, const Positions& shape, int frames, int level_index, int first,
                int last, StereoRefinementOptions refinement = {},
                const std::vector<cv::Mat>* silhouettes = nullptr)
+      : OpenedWindow(scene, std::vector<Positions>(frames, shape), level_index, first, last, refinement,
+                     silhouettes) {}
+  // The same with one shape per frame (the images stay the static scene's).
+  OpenedWindow(const RefinementScene& scene, std::vector<Positions> shapes, int level_index, int first, int last,
+               StereoRefinementOptions refinement = {}, const std::vector<cv::Mat>* silhouettes = nullptr)
       : options(refinement),
-        sequence(scene.Sequence(frames, silhouettes)),
-        control(frames, shape),
+        sequence(scene.Sequence(static_cast<int>(shapes.size()), silhouettes)),
+        control(std::move(shapes)),
         trajectory(geometry::AnalyzeTrajectory(scene.scene.hierarchy, control)),
         cache(std::make_unique<FrameImageCache>(sequence, options.image_sigma)) {
     const geometry::LoopHierarchy& hierarchy = scene.scene.hierarchy;
