@@ -180,7 +180,7 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
                         "sparse_normal_cholesky, sparse_schur, iterative_schur, cgnr, dense_qr",
                         "Ceres linear solver type (ceres::LinearSolverType, any case)");
   sub->add_option("--iterative-from-unknowns", o->solver.iterative_from_unknowns,
-                  "Windows with at least this many unknowns use --iterative-solver instead (0 = never)")
+                  "Windows with at least this many vertex blocks (frames x vertices) use --iterative-solver instead (0 = never)")
       ->capture_default_str();
   AddLinearSolverOption(sub, "--iterative-solver", &o->solver.iterative_solver, "cgnr, iterative_schur",
                         "Ceres linear solver of the large windows (ceres::LinearSolverType, any case)");

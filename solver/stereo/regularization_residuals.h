@@ -10,11 +10,12 @@
 //                        only, since the base control points' world trajectories
 //                        accelerate with the rigid motion itself (a rotating or swinging
 //                        object), which a smoothness term would fight;
-//   slide coherence      w_c/h T_tᵀ (B_t e_t − B_{t−1} e_{t−1}) where the vertex may slide
+//   slide coherence      w_c/h T_tᵀ (B_t e_t − B_{t+1} e_{t+1}) where the vertex may slide
 //                        (dof 3; with tangential_only_at_outlines, where it slides at t or
-//                        t − 1): the first difference of its tangential increments in frame
+//                        t + 1): the first difference of its tangential increments in frame
 //                        t's tangent plane T_t (the basis' columns 1 and 2), so that the
-//                        vertex slides alike over the frames (2 residuals);
+//                        vertex slides alike over the frames (2 residuals; a frame after
+//                        the window enters with its current value);
 //   damping              w_d/h e_v;
 //   bounds               |e_v,d| ≤ max_step · h per component and, for the normal-only
 //                        parametrization, c(ℓ)_v + n e_v inside the working volume (the

@@ -77,17 +77,13 @@ WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options, bool 
 }
 
 // Whether the windows of `level` run as two halves side by side (concurrent_halves): kAuto
-// when a window of the level (its frames × the active patches' corners × dof unknowns)
+// when a window of the level (its frames × the active patches' corners vertex blocks)
 // goes to the iterative solver, whose products run on one thread.
 bool SideBySide(const StereoRefinementOptions& options, const RefinementLevel& level, int frames) {
   if (options.concurrent_halves != ConcurrentHalves::kAuto) return options.concurrent_halves == ConcurrentHalves::kOn;
   const std::int64_t vertices = std::count(level.active_vertices.begin(), level.active_vertices.end(), 1);
-  // Held to their normals, most vertices of a dof-3 level count once (the few that
-  // measured outlines move count thrice, not estimated here).
-  const int per_vertex = level.dof == 3 && options.tangential_only_at_outlines ? 1 : level.dof;
-  const std::int64_t unknowns = vertices * per_vertex * std::min(options.window, frames);
-  return options.solver.Iterative(
-      static_cast<int>(std::min<std::int64_t>(unknowns, std::numeric_limits<int>::max())));
+  const std::int64_t blocks = vertices * std::min(options.window, frames);
+  return options.solver.Iterative(static_cast<int>(std::min<std::int64_t>(blocks, std::numeric_limits<int>::max())));
 }
 
 // The refinement state of the whole sequence, which the windows' solutions move.
@@ -287,13 +283,13 @@ void WindowSolverOptions::Check() const {
     ThrowError("stereo refinement options", "solver.iterative_solver", why);
 }
 
-bool WindowSolverOptions::Iterative(int unknowns) const {
-  return iterative_from_unknowns > 0 && unknowns >= iterative_from_unknowns;
+bool WindowSolverOptions::Iterative(int vertex_blocks) const {
+  return iterative_from_unknowns > 0 && vertex_blocks >= iterative_from_unknowns;
 }
 
-ceres::Solver::Options WindowSolverOptions::ToCeres(int unknowns) const {
+ceres::Solver::Options WindowSolverOptions::ToCeres(int vertex_blocks) const {
   ceres::Solver::Options options;
-  const bool iterative = Iterative(unknowns);
+  const bool iterative = Iterative(vertex_blocks);
   options.linear_solver_type = iterative ? iterative_solver : linear_solver;
   if (iterative) options.eta = iterative_eta;
   options.max_num_iterations = max_iterations;

@@ -85,8 +85,12 @@ struct WindowSolverOptions {
   // 0.0425 / 89 s, 1e-2 → 0.428 mm / 0.0430 / 74 s; bust_front 8 frames, 1e-4 → 1.109 mm
   // / 0.0568 / 39 s, 3e-3 → 1.095 mm / 0.0556 / 29 s.
   double function_tolerance = 3e-3;
-  // Windows with at least this many unknowns use iterative_solver instead of linear_solver
-  // (0 = never). The sparse Cholesky factor of a window fills in with its size (a surface
+  // Windows with at least this many free vertex blocks (vertex × frame: the unknowns of a
+  // normal-only window; a dof-3 vertex counts once) use iterative_solver instead of
+  // linear_solver (0 = never). Counted in blocks, not scalar unknowns: with dof 3 on the
+  // base level (--slide-at-outlines) pair_dome's windows of ~2,650 blocks (7,950 unknowns)
+  // took 65.0 s at that level with cgnr and 46.5 s factorized (the same accuracy: 0.767 /
+  // 0.761 mm P90). The sparse Cholesky factor of a window fills in with its size (a surface
   // over several frames): on the real pose2sim take (HD, 3,000–76,000 unknowns a window)
   // frames 0–11 took 57.7 s in Ceres with sparse_normal_cholesky and 19.3 s with cgnr
   // (mean NCC after 0.6045 / 0.5995), while on the blob (≤ 4,600 unknowns a window)
@@ -103,10 +107,10 @@ struct WindowSolverOptions {
   bool reduced_correlation_blocks = true;
 
   void Check() const;  // throws subflow::Error naming the field (and what Ceres objects to)
-  // ceres::Solver::Options with these settings for a window of `unknowns` scalar unknowns,
-  // silent.
-  ceres::Solver::Options ToCeres(int unknowns = 0) const;
-  bool Iterative(int unknowns) const;  // whether such a window uses iterative_solver
+  // ceres::Solver::Options with these settings for a window of `vertex_blocks` free
+  // increment blocks, silent.
+  ceres::Solver::Options ToCeres(int vertex_blocks = 0) const;
+  bool Iterative(int vertex_blocks) const;  // whether such a window uses iterative_solver
 };
 
 struct StereoRefinementOptions {

@@ -115,6 +115,7 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
   solution.first = window.first;
   solution.last = window.last;
   solution.parameters = BoundIncrements(window, bounds, &problem);
+  solution.vertex_blocks = solution.parameters / window.dof;
   if (window.dof == 3 && options.tangential_only_at_outlines) {
     const int held = HoldToNormals(window, &normal_only, &problem);
     spdlog::debug("refinement level {} frames {}–{}: {} of {} vertex blocks held to their normals", window.level,
@@ -131,9 +132,9 @@ WindowSolution SolveWindow(RefinementWindow& window, const vision::Bounds& bound
   Evaluate(problem, silhouette, false, options.silhouette_weight, frames, &silhouette_before, &silhouette_count);
   if (problem.NumParameterBlocks() > 0 && problem.NumResidualBlocks() > 0) {
     ceres::Solver::Summary summary;
-    solution.iterative = options.solver.Iterative(solution.parameters);  // as ToCeres chooses
+    solution.iterative = options.solver.Iterative(solution.vertex_blocks);  // as ToCeres chooses
     const Stopwatch solve_start;
-    ceres::Solve(options.solver.ToCeres(solution.parameters), &problem, &summary);
+    ceres::Solve(options.solver.ToCeres(solution.vertex_blocks), &problem, &summary);
     solution.solver_seconds = solve_start.Seconds();
     solution.iterations = static_cast<int>(summary.iterations.size());
     std::string costs;  // and the linear solver's iterations in brackets

@@ -34,6 +34,7 @@ struct WindowSolution {
   std::vector<geometry::Positions> displacement;
   std::vector<WindowFrameFigures> frames;  // per frame first..last
   int parameters = 0;       // free scalar unknowns
+  int vertex_blocks = 0;    // free increment blocks (vertex × frame): what chooses the solver
   int residual_blocks = 0;
   int iterations = 0;       // Ceres iterations
   // Solved by options.solver.iterative_solver (else by linear_solver, or not at all: a

@@ -151,12 +151,12 @@ TEST(TemporalSmoothnessResidual, SecondDifferencesOfIncrementsAtLevelZeroAndOfDe
 
 // The first difference of the tangential increments in frame t's tangent plane: a vertex
 // that slides alike in both frames costs nothing, whatever it does along its normal; one
-// that slides differently costs w/h times the difference. None at the sequence's first
+// that slides differently costs w/h times the difference. None at the sequence's last
 // frame, and none for a vertex held to its normal in both frames.
 TEST(SlideCoherenceResidual, FirstDifferencesOfTheSlidingInFrameTsTangentPlane) {
   HandWindow hand(0, 3, 1, 2);
   ceres::Problem problem;
-  AddSlideCoherenceResidual(hand.window, 2, 7, &problem);
+  AddSlideCoherenceResidual(hand.window, 1, 7, &problem);
   const ceres::ResidualBlockId id = OnlyBlock(problem);
   ASSERT_NE(id, nullptr);
   hand.SetIncrement(1, 7, Eigen::Vector3d(0.03, 0.01, -0.02));
@@ -164,18 +164,18 @@ TEST(SlideCoherenceResidual, FirstDifferencesOfTheSlidingInFrameTsTangentPlane) 
   EXPECT_LT(Residual(problem, id).norm(), 1e-15);
   hand.SetIncrement(2, 7, Eigen::Vector3d(-0.05, 0.04, -0.02));
   const double w = hand.options.slide_coherence / hand.window.h;
-  EXPECT_NEAR((Residual(problem, id) - Eigen::Vector2d(w * 0.03, 0.0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((Residual(problem, id) - Eigen::Vector2d(-w * 0.03, 0.0)).norm(), 0.0, 1e-15);
 
-  ceres::Problem first;
-  AddSlideCoherenceResidual(hand.window, 0, 7, &first);
-  EXPECT_EQ(first.NumResidualBlocks(), 0);
+  ceres::Problem last;
+  AddSlideCoherenceResidual(hand.window, 2, 7, &last);
+  EXPECT_EQ(last.NumResidualBlocks(), 0);
 
   hand.options.tangential_only_at_outlines = true;
   ceres::Problem held;
-  AddSlideCoherenceResidual(hand.window, 2, 7, &held);
+  AddSlideCoherenceResidual(hand.window, 1, 7, &held);
   EXPECT_EQ(held.NumResidualBlocks(), 0);
-  hand.window.sliding.insert(hand.window.Increment(1, 7));
-  AddSlideCoherenceResidual(hand.window, 2, 7, &held);
+  hand.window.sliding.insert(hand.window.Increment(2, 7));
+  AddSlideCoherenceResidual(hand.window, 1, 7, &held);
   EXPECT_EQ(held.NumResidualBlocks(), 1);
 }
 
