@@ -89,8 +89,8 @@ struct WindowSolverOptions {
   // normal-only window; a dof-3 vertex counts once) use iterative_solver instead of
   // linear_solver (0 = never). Counted in blocks, not scalar unknowns: with dof 3 on the
   // base level (--slide-at-outlines) pair_dome's windows of ~2,650 blocks (7,950 unknowns)
-  // took 65.0 s at that level with cgnr and 46.5 s factorized (the same accuracy: 0.767 /
-  // 0.761 mm P90). The sparse Cholesky factor of a window fills in with its size (a surface
+  // took 65.0 s at that level with cgnr and 47.0 s factorized (the same accuracy: 0.767 /
+  // 0.7665 mm P90). The sparse Cholesky factor of a window fills in with its size (a surface
   // over several frames): on the real pose2sim take (HD, 3,000–76,000 unknowns a window)
   // frames 0–11 took 57.7 s in Ceres with sparse_normal_cholesky and 19.3 s with cgnr
   // (mean NCC after 0.6045 / 0.5995), while on the blob (≤ 4,600 unknowns a window)

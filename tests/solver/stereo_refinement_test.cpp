@@ -169,7 +169,7 @@ TEST(StereoRefinement, WindowsRecordTheirLinearSolver) {
 
 // The solver is chosen by a window's vertex blocks, not its scalar unknowns: a dof-3 window
 // of B blocks (3B unknowns) is factorized below a threshold of B + 1 and iterative at B
-// (factorized, pair_dome's dof-3 base level took 46.5 s instead of cgnr's 65.0 s).
+// (factorized, pair_dome's dof-3 base level took 47.0 s instead of cgnr's 65.0 s).
 TEST(StereoRefinement, ADof3WindowIsCountedInVertexBlocks) {
   StereoRefinementOptions options = TestOptions();
   options.normal_only_from_level = 1;
