@@ -200,7 +200,7 @@ void AddRefinementOptions(CLI::App* sub, solver::StereoRefinementOptions* o) {
         o->tangential_only_at_outlines = true;
       },
       "Base level: vertices at measured outlines (masks, a plain backdrop, a background image) may also slide along "
-      "the surface (thin parts 3-9 % more accurate on the scenes; the refinement 1.2-3x slower)");
+      "the surface (1-8 % more accurate on the scenes; the refinement 1.5-2.5x slower)");
   sub->add_option("--slide-coherence", o->slide_coherence,
                   "Where vertices slide: weight of the first difference of their sliding over the frames")
       ->capture_default_str();

@@ -55,12 +55,12 @@ void AddTemporalSmoothnessResidual(RefinementWindow& window, int frame, int vert
 
 void AddSlideCoherenceResidual(RefinementWindow& window, int frame, int vertex, ceres::Problem* problem) {
   const double weight = window.options->slide_coherence;
-  // Frame t against t + 1 (the last solved frame against the next, unrefined one, which the
-  // next window solves again with it): measured against t − 1 against t, which ties the
-  // first frame to the previous window's result instead, on bust_front, pair_dome and
-  // critter_ring with --slide-at-outlines (observed accuracy P90 mm / EPE_rel):
-  // 0.6516 / 0.0564, 0.7637 / 0.1088, 0.7264 / 0.0939 against 0.6575 / 0.0572, 0.7665 /
-  // 0.1096, 0.7224 / 0.0947.
+  // Frame t with t + 1 (so a window's last frame with the next, unrefined one, which the
+  // next window solves again with it). Pairing t − 1 with t instead (a window's first frame
+  // with the previous window's result) was worse on five of six figures of bust_front,
+  // pair_dome and critter_ring with --slide-at-outlines (observed accuracy P90 mm /
+  // EPE_rel): 0.6575 / 0.0572, 0.7665 / 0.1096, 0.7224 / 0.0947 against 0.6516 / 0.0564,
+  // 0.7637 / 0.1088, 0.7264 / 0.0939 with t + 1.
   if (weight <= 0 || window.dof != 3 || frame >= window.SpanLast() || !window.states.count(frame + 1)) return;
   double* now = window.Increment(frame, vertex);
   double* after = window.Increment(frame + 1, vertex);

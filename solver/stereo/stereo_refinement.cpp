@@ -77,7 +77,7 @@ WindowPlan PlanWindows(int frames, const StereoRefinementOptions& options, bool 
 }
 
 // Whether the windows of `level` run as two halves side by side (concurrent_halves): kAuto
-// when a window of the level (its frames × the active patches' corners vertex blocks)
+// when a window of the level (its frames × the active patches' corners: vertex blocks)
 // goes to the iterative solver, whose products run on one thread.
 bool SideBySide(const StereoRefinementOptions& options, const RefinementLevel& level, int frames) {
   if (options.concurrent_halves != ConcurrentHalves::kAuto) return options.concurrent_halves == ConcurrentHalves::kOn;
