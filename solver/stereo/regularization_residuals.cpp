@@ -61,7 +61,7 @@ void AddSlideCoherenceResidual(RefinementWindow& window, int frame, int vertex, 
   // pair_dome and critter_ring with --slide-at-outlines (observed accuracy P90 mm /
   // EPE_rel): 0.6575 / 0.0572, 0.7665 / 0.1096, 0.7224 / 0.0947 against 0.6516 / 0.0564,
   // 0.7637 / 0.1088, 0.7264 / 0.0939 with t + 1.
-  if (weight <= 0 || window.dof != 3 || frame >= window.SpanLast() || !window.states.count(frame + 1)) return;
+  if (weight <= 0 || window.dof != 3 || !window.states.count(frame + 1)) return;  // states end at SpanLast()
   double* now = window.Increment(frame, vertex);
   double* after = window.Increment(frame + 1, vertex);
   if (window.options->tangential_only_at_outlines && !window.sliding.count(now) && !window.sliding.count(after))
